@@ -1,0 +1,16 @@
+"""Rigorous interval arithmetic over NumPy arrays (forward and backward operators).
+
+Names that would shadow Python builtins (``abs``, ``min``, ``max``, ``pow``) are reachable as
+``boundest.abs`` etc. but are left out of ``__all__`` so that ``from boundest import *`` is safe.
+"""
+
+from . import algebraic, explog, trig
+from .algebraic import *  # noqa: F403
+from .arith import add, div, mul, neg, recip, sqr, sqrt, sub
+from .core import Interval, IntervalVector, as_interval, hull, intersect
+from .explog import *  # noqa: F403
+from .trig import *  # noqa: F403
+
+__all__ = ["Interval", "IntervalVector", "as_interval", "hull", "intersect",
+           "add", "sub", "mul", "div", "neg", "recip", "sqr", "sqrt",
+           *algebraic.__all__, *explog.__all__, *trig.__all__]
