@@ -160,8 +160,9 @@ def mul_dn(a: float, b: float) -> float:
         return 0.0
     p = a * b
     e = _mul_err(a, b, p)
-    if e != e:
-        return next_down(p)
+    if e != e:  # underflow: step blindly, but the sign of a*b is known
+        r = next_down(p)
+        return max(r, 0.0) if (a > 0.0) == (b > 0.0) else r
     return _lower(p, e)
 
 
@@ -173,7 +174,8 @@ def mul_up(a: float, b: float) -> float:
     p = a * b
     e = _mul_err(a, b, p)
     if e != e:
-        return next_up(p)
+        r = next_up(p)
+        return min(r, 0.0) if (a > 0.0) != (b > 0.0) else r
     return _upper(p, e)
 
 
@@ -196,7 +198,8 @@ def div_dn(a: float, b: float) -> float:
     q = a / b
     e = _div_err(a, b, q)
     if e != e:
-        return next_down(q)
+        r = next_down(q)
+        return max(r, 0.0) if (a > 0.0) == (b > 0.0) else r
     return _lower(q, e)
 
 
@@ -206,7 +209,8 @@ def div_up(a: float, b: float) -> float:
     q = a / b
     e = _div_err(a, b, q)
     if e != e:
-        return next_up(q)
+        r = next_up(q)
+        return min(r, 0.0) if (a > 0.0) != (b > 0.0) else r
     return _upper(q, e)
 
 
@@ -267,7 +271,8 @@ class _LazyGufunc:
 
     def __call__(self, *args, **kwargs):
         ufunc = self._ufunc or self._build()
-        return ufunc(*args, **kwargs)
+        with np.errstate(all="ignore"):  # overflow and inf - inf are expected inside kernels
+            return ufunc(*args, **kwargs)
 
 
 def gufunc(nin: int, nout: int = 2) -> Callable[[Callable], _LazyGufunc]:

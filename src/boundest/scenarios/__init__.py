@@ -1,0 +1,1 @@
+"""The seed problems and demos, each runnable end to end on embedded data."""

@@ -1,0 +1,153 @@
+"""Soundness and tightness of + - * / sqr sqrt against exact rational / mpmath results."""
+
+from __future__ import annotations
+
+import math
+from fractions import Fraction
+
+import mpmath
+import numpy as np
+import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
+
+import boundest as bd
+from boundest import Interval
+
+from .strategies import intervals, point_in, ulps_apart
+
+mpmath.mp.prec = 256
+EMPTY = Interval.empty()
+ENTIRE = Interval.entire()
+
+
+def exact_in(value: Fraction | float, x: Interval) -> bool:
+    """Whether an exact real value lies in the float interval ``x``."""
+    lo, hi = float(x.lo), float(x.hi)
+    if math.isnan(lo):
+        return False
+    return (lo == -math.inf or Fraction(lo) <= value) and (hi == math.inf or value <= Fraction(hi))
+
+
+OPS = {
+    "add": (bd.add, lambda a, b: a + b),
+    "sub": (bd.sub, lambda a, b: a - b),
+    "mul": (bd.mul, lambda a, b: a * b),
+    "div": (bd.div, lambda a, b: a / b),
+}
+
+
+@pytest.mark.parametrize("name", sorted(OPS))
+@settings(max_examples=400, deadline=None)
+@given(data=st.data())
+def test_binary_contains_exact_result(name, data):
+    op, exact = OPS[name]
+    x, y = data.draw(intervals()), data.draw(intervals())
+    a, b = data.draw(point_in(x)), data.draw(point_in(y))
+    assume(not (name == "div" and b == 0.0))
+    z = op(x, y)
+    assert exact_in(exact(Fraction(a), Fraction(b)), z), (x, y, a, b, z)
+
+
+@pytest.mark.parametrize("name", sorted(OPS))
+@settings(max_examples=300, deadline=None)
+@given(data=st.data())
+def test_binary_on_degenerate_is_tightest(name, data):
+    a = data.draw(st.floats(-1e200, 1e200))
+    b = data.draw(st.floats(-1e200, 1e200))
+    assume(not (name == "div" and b == 0.0))
+    op, exact = OPS[name]
+    z = op(Interval(a), Interval(b))
+    e = exact(Fraction(a), Fraction(b))
+    lo, hi = float(z.lo), float(z.hi)
+    assert exact_in(e, z)
+    if not (math.isfinite(lo) and math.isfinite(hi)):  # overflow: [MAX, inf] or [-inf, -MAX]
+        assert abs(e) > Fraction(1.7976931348623157e308)
+        return
+    # tightest: either the exact value is a float (degenerate result) or lo, hi are adjacent
+    if Fraction(lo) == e:
+        assert lo == hi
+    elif min(abs(a), abs(b), abs(e)) > 2.0**-900:
+        assert ulps_apart(lo, hi) == 1, (a, b, lo, hi)
+    else:  # near the subnormal range the kernels step out blindly: a few ulps
+        assert ulps_apart(lo, hi) <= 4
+
+
+@settings(max_examples=400, deadline=None)
+@given(data=st.data())
+def test_sqr_sqrt_contain_exact_result(data):
+    x = data.draw(intervals())
+    a = data.draw(point_in(x))
+    assert exact_in(Fraction(a) ** 2, bd.sqr(x))
+    if a >= 0:
+        r = bd.sqrt(x)
+        s = mpmath.sqrt(mpmath.mpf(a))
+        assert mpmath.mpf(float(r.lo)) <= s <= mpmath.mpf(float(r.hi))
+
+
+def test_division_by_intervals_containing_zero():
+    one_two = Interval(1, 2)
+    assert bd.div(one_two, Interval(0, 0)).is_empty()
+    assert bd.div(one_two, Interval(-1, 1)) == ENTIRE
+    assert bd.div(one_two, Interval(0, 4)) == Interval(0.25, np.inf)
+    assert bd.div(one_two, Interval(-4, 0)) == Interval(-np.inf, -0.25)
+    assert bd.div(Interval(-2, -1), Interval(0, 4)) == Interval(-np.inf, -0.25)
+    assert bd.div(Interval(-1, 2), Interval(0, 4)) == ENTIRE
+    assert bd.div(Interval(0, 0), Interval(-1, 1)) == Interval(0, 0)
+    assert bd.div(Interval(1, np.inf), Interval(1, np.inf)) == Interval(0, np.inf)
+
+
+def test_seed_004_examples():
+    # seed 004 section 6.1
+    assert bd.add(Interval(-1, 3), Interval(2, 5)) == Interval(1, 8)
+    assert bd.mul(Interval(-1, 3), Interval(2, 5)) == Interval(-5, 15)
+    assert bd.div(Interval(-1, 3), Interval(2, 5)) == Interval(-0.5, 1.5)
+    assert bd.sqr(Interval(-1, 3)) == Interval(0, 9)
+    assert bd.sqrt(Interval(-10, 4)) == Interval(0, 2)
+
+
+def test_empty_and_entire_propagate():
+    for op in (bd.add, bd.sub, bd.mul, bd.div):
+        assert op(EMPTY, Interval(1, 2)).is_empty()
+        assert op(Interval(1, 2), EMPTY).is_empty()
+    assert bd.sqr(EMPTY).is_empty() and bd.sqrt(EMPTY).is_empty()
+    assert bd.sqrt(Interval(-3, -1)).is_empty()
+    assert bd.mul(Interval(0, 0), ENTIRE) == Interval(0, 0)
+    assert bd.mul(ENTIRE, Interval(1, 2)) == ENTIRE
+    assert bd.add(ENTIRE, Interval(1, 2)) == ENTIRE
+    assert bd.sqr(ENTIRE) == Interval(0, np.inf)
+
+
+def test_overflow_gives_infinite_upper_bound_not_infinite_lower():
+    big = Interval(1e308, 1.7976931348623157e308)
+    s = big + big
+    assert s.lo == 1.7976931348623157e308 and s.hi == np.inf
+    p = -big * big
+    assert p.lo == -np.inf and p.hi == -1.7976931348623157e308
+
+
+def test_signed_zero_and_tiny_products():
+    z = bd.mul(Interval(-0.0, 0.0), Interval(-np.inf, np.inf))
+    assert z == Interval(0, 0)
+    t = bd.mul(Interval(2.0**-600), Interval(2.0**-600))  # underflows to 0
+    assert t.lo <= 0.0 < t.hi or (t.lo < 2.0**-1200 < t.hi)
+    assert float(t.lo) >= 0.0  # exact product is positive: lower bound not below 0
+
+
+def test_broadcasting_and_out_buffers():
+    x = Interval(np.zeros((3, 4)), np.ones((3, 4)))
+    y = Interval(np.arange(4.0), np.arange(4.0) + 1)
+    z = x + y
+    assert z.shape == (3, 4)
+    assert np.array_equal(z.lo, np.broadcast_to(np.arange(4.0), (3, 4)))
+    out = Interval.empty((3, 4))
+    r = bd.mul(x, y, out=out)
+    assert r is out and np.array_equal(out.hi, np.broadcast_to(np.arange(4.0) + 1, (3, 4)))
+    assert (2 * x).shape == (3, 4) and (x - 1.0).shape == (3, 4) and (1.0 / y).shape == (4,)
+
+
+def test_reflected_operators_with_numpy_scalars():
+    x = Interval(1, 2)
+    assert np.float64(2) * x == Interval(2, 4)
+    assert 1 - x == Interval(-1, 0)
+    assert 2 / x == Interval(1, 2)
