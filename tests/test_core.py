@@ -66,6 +66,7 @@ def test_set_operations():
     assert Interval(0.5, 1).is_interior_subset(a) and not Interval(0, 1).is_interior_subset(a)
     assert a.contains(2.0) and not a.contains(2.5) and 1.0 in a
     assert not Interval.empty().contains(0.0)
+    assert not Interval.entire().contains(np.inf) and not Interval.entire().contains(-np.inf)
     assert a.intersects(b) and not a.intersects(Interval(3, 4))
     assert bd.hull(Interval([0, 5], [1, 6]), axis=0) == Interval(0, 6)
 

@@ -44,3 +44,23 @@ def test_infinities_and_nan():
     assert dn == -np.inf and up == -MAX
     assert all(np.isnan(v) for v in _steps(np.nan))
     assert _steps(0.0)[0] == -(2.0**-1074) and _steps(0.0)[1] == 2.0**-1074
+
+
+def test_kernels_refuse_to_run_with_upward_rounding():
+    import ctypes
+    import ctypes.util
+
+    import pytest
+
+    import boundest as bd
+
+    libm = ctypes.CDLL(ctypes.util.find_library("m"))
+    fe_upward, fe_tonearest = 0x800, 0x000  # x86-64 glibc values
+    assert libm.fegetround() == fe_tonearest
+    libm.fesetround(fe_upward)
+    try:
+        with pytest.raises(FloatingPointError, match="round-to-nearest"):
+            bd.Interval(1, 2) + bd.Interval(3, 4)
+    finally:
+        libm.fesetround(fe_tonearest)
+    assert bd.Interval(1, 2) + 1 == bd.Interval(2, 3)

@@ -4,12 +4,16 @@ Names that would shadow Python builtins (``abs``, ``min``, ``max``, ``pow``) are
 ``boundest.abs`` etc. but are left out of ``__all__`` so that ``from boundest import *`` is safe.
 """
 
-from . import algebraic, explog, trig
-from .algebraic import *  # noqa: F403
-from .arith import add, div, mul, neg, recip, sqr, sqrt, sub
-from .core import Interval, IntervalVector, as_interval, hull, intersect
-from .explog import *  # noqa: F403
-from .trig import *  # noqa: F403
+from .._numba_cache import drop_stale_numba_cache
+
+drop_stale_numba_cache()
+
+from . import algebraic, explog, trig  # noqa: E402
+from .algebraic import *  # noqa: E402, F403
+from .arith import add, div, mul, neg, recip, sqr, sqrt, sub  # noqa: E402
+from .core import Interval, IntervalVector, as_interval, hull, intersect  # noqa: E402
+from .explog import *  # noqa: E402, F403
+from .trig import *  # noqa: E402, F403
 
 __all__ = ["Interval", "IntervalVector", "as_interval", "hull", "intersect",
            "add", "sub", "mul", "div", "neg", "recip", "sqr", "sqrt",

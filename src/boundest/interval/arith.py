@@ -1,10 +1,11 @@
 """Forward arithmetic ``+ - * /``, ``sqr``, ``sqrt``: tightest float64 enclosures.
 
-Each operation is one fused Numba gufunc over the bound arrays (broadcasting, ``out=``).
+Each bound is one Numba ufunc over the bound arrays (broadcasting, ``out=``, SIMD loops).
 """
 
 from __future__ import annotations
 
+import numba as nb
 from numpy.typing import ArrayLike
 
 from .core import Interval, as_interval
@@ -15,153 +16,175 @@ from .rounding import (
     add_up,
     div_dn,
     div_up,
-    gufunc,
     mul_dn,
     mul_up,
     sqrt_dn,
     sqrt_up,
     sub_dn,
     sub_up,
+    ufunc,
 )
 
 __all__ = ["add", "div", "mul", "neg", "recip", "sqr", "sqrt", "sub"]
 
 IntervalLike = ArrayLike | Interval
+_njit = nb.njit(cache=True)
 
 
-@gufunc(4)
-def _add(al, ah, bl, bh, lo, hi):
-    lo[0] = add_dn(al, bl)
-    hi[0] = add_up(ah, bh)
+# One branch-free scalar kernel per bound (selects, no jumps), so that Numba's ufunc loops
+# vectorise them; the rare cases (empty, zero in a divisor) are selected at the end.
+@ufunc(4)
+def _add_lo(al, ah, bl, bh):  # noqa: ARG001 - all kernels of a binary op share a signature
+    return add_dn(al, bl)
 
 
-@gufunc(4)
-def _sub(al, ah, bl, bh, lo, hi):
-    lo[0] = sub_dn(al, bh)
-    hi[0] = sub_up(ah, bl)
+@ufunc(4)
+def _add_hi(al, ah, bl, bh):  # noqa: ARG001
+    return add_up(ah, bh)
 
 
-@gufunc(4)
-def _mul(al, ah, bl, bh, lo, hi):
-    if al != al or bl != bl:
-        lo[0] = NAN
-        hi[0] = NAN
-        return
-    lo[0] = min(min(mul_dn(al, bl), mul_dn(al, bh)), min(mul_dn(ah, bl), mul_dn(ah, bh)))
-    hi[0] = max(max(mul_up(al, bl), mul_up(al, bh)), max(mul_up(ah, bl), mul_up(ah, bh)))
+@ufunc(4)
+def _sub_lo(al, ah, bl, bh):  # noqa: ARG001
+    return sub_dn(al, bh)
 
 
-@gufunc(4)
-def _div(al, ah, bl, bh, lo, hi):
-    if al != al or bl != bl or (bl == 0.0 and bh == 0.0):
-        lo[0] = NAN
-        hi[0] = NAN
-        return
-    if al == 0.0 and ah == 0.0:
-        lo[0] = 0.0
-        hi[0] = 0.0
-        return
-    if bl > 0.0 or bh < 0.0:
-        # 0 not in the divisor: the extreme quotients are at corners; an inf/inf corner has no
-        # limit and is dominated by the others, so it is skipped.
-        l0 = INF
-        h0 = -INF
-        for a in (al, ah):
-            for b in (bl, bh):
-                if abs(a) == INF and abs(b) == INF:
-                    continue
-                l0 = min(l0, div_dn(a, b))
-                h0 = max(h0, div_up(a, b))
-        lo[0] = l0
-        hi[0] = h0
-        return
-    if bl == 0.0:  # divisor [0, bh], bh > 0
-        if ah < 0.0:
-            lo[0] = -INF
-            hi[0] = div_up(ah, bh)
-        elif al > 0.0:
-            lo[0] = div_dn(al, bh)
-            hi[0] = INF
-        else:
-            lo[0] = -INF
-            hi[0] = INF
-        return
-    if bh == 0.0:  # divisor [bl, 0], bl < 0
-        if ah < 0.0:
-            lo[0] = div_dn(ah, bl)
-            hi[0] = INF
-        elif al > 0.0:
-            lo[0] = -INF
-            hi[0] = div_up(al, bl)
-        else:
-            lo[0] = -INF
-            hi[0] = INF
-        return
-    lo[0] = -INF  # 0 strictly inside the divisor
-    hi[0] = INF
+@ufunc(4)
+def _sub_hi(al, ah, bl, bh):  # noqa: ARG001
+    return sub_up(ah, bl)
 
 
-@gufunc(2)
-def _sqr(al, ah, lo, hi):
-    if al >= 0.0:
-        lo[0] = mul_dn(al, al)
-        hi[0] = mul_up(ah, ah)
-    elif ah <= 0.0:
-        lo[0] = mul_dn(ah, ah)
-        hi[0] = mul_up(al, al)
-    elif al == al:
-        lo[0] = 0.0
-        hi[0] = max(mul_up(al, al), mul_up(ah, ah))
-    else:
-        lo[0] = NAN
-        hi[0] = NAN
+@_njit
+def _min(a, b):
+    return a if a < b else b  # a plain select (Numba's min() also checks for NaN)
 
 
-@gufunc(2)
-def _sqrt(al, ah, lo, hi):
-    if not ah >= 0.0:  # empty, or entirely negative
-        lo[0] = NAN
-        hi[0] = NAN
-        return
-    lo[0] = sqrt_dn(max(al, 0.0))
-    hi[0] = sqrt_up(ah)
+@_njit
+def _max(a, b):
+    return a if a > b else b
 
 
-def _binary(kernel, x: IntervalLike, y: IntervalLike, out: Interval | None) -> Interval:
+@ufunc(4)
+def _mul_lo(al, ah, bl, bh):
+    r = _min(_min(mul_dn(al, bl), mul_dn(al, bh)), _min(mul_dn(ah, bl), mul_dn(ah, bh)))
+    r = NAN if al != al else r
+    return NAN if bl != bl else r
+
+
+@ufunc(4)
+def _mul_hi(al, ah, bl, bh):
+    r = _max(_max(mul_up(al, bl), mul_up(al, bh)), _max(mul_up(ah, bl), mul_up(ah, bh)))
+    r = NAN if al != al else r
+    return NAN if bl != bl else r
+
+
+@_njit
+def _cdn(a, b):
+    """Lower bound of the corner ``a/b``; ``a/inf = 0``; ``inf/inf`` has no limit and gives 0
+    too, which the corner ``a/inf`` of the same quotient always reaches (NaN inputs are
+    handled by the caller)."""
+    r = div_dn(a, b)
+    r = 0.0 if abs(b) == INF else r  # a / inf = 0 exactly (inf / inf: 0 is dominated too)
+    return INF if r != r else r
+
+
+@_njit
+def _cup(a, b):
+    r = div_up(a, b)
+    r = 0.0 if abs(b) == INF else r
+    return -INF if r != r else r
+
+
+# Nested selects rather than and/or chains: short-circuit logic blocks vectorisation.
+@ufunc(4)
+def _div_lo(al, ah, bl, bh):
+    r = _min(_min(_cdn(al, bl), _cdn(al, bh)), _min(_cdn(ah, bl), _cdn(ah, bh)))
+    # 0 in the divisor: a half-line when a dividend bound and a divisor bound are at 0
+    s = -INF
+    s = (div_dn(al, bh) if al >= 0.0 else s) if bl == 0.0 else s
+    s = (div_dn(ah, bl) if ah <= 0.0 else s) if bh == 0.0 else s
+    s = (0.0 if ah == 0.0 else s) if al == 0.0 else s
+    r = (s if bh >= 0.0 else r) if bl <= 0.0 else r
+    r = (NAN if bh == 0.0 else r) if bl == 0.0 else r  # divisor [0, 0]: empty
+    r = NAN if al != al else r
+    return NAN if bl != bl else r
+
+
+@ufunc(4)
+def _div_hi(al, ah, bl, bh):
+    r = _max(_max(_cup(al, bl), _cup(al, bh)), _max(_cup(ah, bl), _cup(ah, bh)))
+    s = INF
+    s = (div_up(ah, bh) if ah <= 0.0 else s) if bl == 0.0 else s
+    s = (div_up(al, bl) if al >= 0.0 else s) if bh == 0.0 else s
+    s = (0.0 if ah == 0.0 else s) if al == 0.0 else s
+    r = (s if bh >= 0.0 else r) if bl <= 0.0 else r
+    r = (NAN if bh == 0.0 else r) if bl == 0.0 else r
+    r = NAN if al != al else r
+    return NAN if bl != bl else r
+
+
+@ufunc(2)
+def _sqr_lo(al, ah):
+    r = mul_dn(al, al) if al >= 0.0 else (mul_dn(ah, ah) if ah <= 0.0 else 0.0)
+    return NAN if al != al else r
+
+
+@ufunc(2)
+def _sqr_hi(al, ah):
+    return max(mul_up(al, al), mul_up(ah, ah))  # NaN stays NaN: both are NaN
+
+
+@ufunc(2)
+def _sqrt_lo(al, ah):
+    r = sqrt_dn(max(al, 0.0))
+    return r if ah >= 0.0 else NAN  # empty, or entirely negative
+
+
+@ufunc(2)
+def _sqrt_hi(al, ah):  # noqa: ARG001
+    r = sqrt_up(ah)
+    return r if ah >= 0.0 else NAN
+
+
+def _binary(klo, khi, x: IntervalLike, y: IntervalLike, out: Interval | None) -> Interval:
     x, y = as_interval(x), as_interval(y)
+    args = (x.lo, x.hi, y.lo, y.hi)
     if out is None:
-        return Interval._new(*kernel(x.lo, x.hi, y.lo, y.hi))
-    kernel(x.lo, x.hi, y.lo, y.hi, out.lo, out.hi)
+        return Interval._new(klo(*args), khi(*args))
+    lo = klo(*args)  # not into out.lo yet: out may be one of the arguments
+    khi(*args, out=out.hi)
+    out.lo[...] = lo
     return out
 
 
-def _unary(kernel, x: IntervalLike, out: Interval | None) -> Interval:
+def _unary(klo, khi, x: IntervalLike, out: Interval | None) -> Interval:
     x = as_interval(x)
     if out is None:
-        return Interval._new(*kernel(x.lo, x.hi))
-    kernel(x.lo, x.hi, out.lo, out.hi)
+        return Interval._new(klo(x.lo, x.hi), khi(x.lo, x.hi))
+    lo = klo(x.lo, x.hi)
+    khi(x.lo, x.hi, out=out.hi)
+    out.lo[...] = lo
     return out
 
 
 def add(x: IntervalLike, y: IntervalLike, out: Interval | None = None) -> Interval:
     """``x + y`` (tightest). ``out`` receives the result in place when given."""
-    return _binary(_add, x, y, out)
+    return _binary(_add_lo, _add_hi, x, y, out)
 
 
 def sub(x: IntervalLike, y: IntervalLike, out: Interval | None = None) -> Interval:
     """``x - y`` (tightest)."""
-    return _binary(_sub, x, y, out)
+    return _binary(_sub_lo, _sub_hi, x, y, out)
 
 
 def mul(x: IntervalLike, y: IntervalLike, out: Interval | None = None) -> Interval:
     """``x * y`` (tightest; ``0 * inf`` counts as 0, so ``[0, 0] * entire = [0, 0]``)."""
-    return _binary(_mul, x, y, out)
+    return _binary(_mul_lo, _mul_hi, x, y, out)
 
 
 def div(x: IntervalLike, y: IntervalLike, out: Interval | None = None) -> Interval:
     """``x / y`` (tightest hull; a divisor containing 0 gives a half-line or the entire line,
     ``y = [0, 0]`` gives the empty set)."""
-    return _binary(_div, x, y, out)
+    return _binary(_div_lo, _div_hi, x, y, out)
 
 
 def recip(x: IntervalLike, out: Interval | None = None) -> Interval:
@@ -177,11 +200,11 @@ def neg(x: IntervalLike) -> Interval:
 
 def sqr(x: IntervalLike, out: Interval | None = None) -> Interval:
     """``x**2`` as one operation (tighter than ``x * x``: ``sqr([-1, 2]) = [0, 4]``)."""
-    return _unary(_sqr, x, out)
+    return _unary(_sqr_lo, _sqr_hi, x, out)
 
 
 def sqrt(x: IntervalLike, out: Interval | None = None) -> Interval:
     """Square root over the part of ``x`` where it is defined (``sqrt([-4, 4]) = [0, 2]``)."""
-    return _unary(_sqrt, x, out)
+    return _unary(_sqrt_lo, _sqrt_hi, x, out)
 
 

@@ -189,11 +189,11 @@ class Interval:
         return np.isfinite(self.lo) & np.isfinite(self.hi) | self.is_empty()
 
     def contains(self, x: ArrayLike | Interval) -> NDArray[np.bool_]:
-        """Whether the point ``x`` lies in the interval (or the interval ``x`` is a subset)."""
+        """Whether the real ``x`` lies in the interval (or the interval ``x`` is a subset)."""
         if isinstance(x, Interval):
             return x.is_subset(self)
         x = np.asarray(x, dtype=np.float64)
-        return (self.lo <= x) & (x <= self.hi)
+        return (self.lo <= x) & (x <= self.hi) & np.isfinite(x)  # infinities are not reals
 
     def __contains__(self, x: ArrayLike | Interval) -> bool:
         return bool(np.all(self.contains(x)))

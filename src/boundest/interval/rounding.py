@@ -59,7 +59,7 @@ LIBM_ULPS = 4
 _LIBM_REL = (LIBM_ULPS + 1) * 2.0**-52
 _LIBM_ABS = LIBM_ULPS * ETA
 
-_jit = nb.njit(inline="always", cache=True)
+_jit = nb.njit(cache=True)  # small helpers: LLVM inlines them, Numba compiles them once
 
 
 @intrinsic
@@ -79,40 +79,37 @@ def fma(typingctx, a, b, c):  # noqa: ARG001 - numba intrinsic signature
 @_jit
 def next_down(x: float) -> float:
     """A float strictly below ``x`` (its predecessor, rarely one further); ``inf -> MAX``."""
-    if x == INF:
-        return MAX
-    return x - (abs(x) * PHI + ETA)
+    r = x - (abs(x) * PHI + ETA)
+    return MAX if x == INF else r
 
 
 @_jit
 def next_up(x: float) -> float:
     """A float strictly above ``x`` (its successor, rarely one further); ``-inf -> -MAX``."""
-    if x == -INF:
-        return -MAX
-    return x + (abs(x) * PHI + ETA)
+    r = x + (abs(x) * PHI + ETA)
+    return -MAX if x == -INF else r
 
 
+# The helpers below are written as selects, not branches: whether a rounded result is exact
+# is random on real data, and a mispredicted branch costs more than the arithmetic.
 @_jit
 def _lower(s: float, err: float) -> float:
-    """Lower bound of ``s + err`` where ``s = RN(exact)`` and ``err`` has the sign of the error."""
-    if s == INF:
-        return MAX
-    if err < 0.0:
-        return next_down(s)
-    return s
+    """Lower bound of the exact value, given ``s = RN(exact)`` and ``err`` with the sign of
+    ``exact - s`` (NaN: unknown, step anyway). An overflow ``s = +inf`` gives ``MAX``."""
+    r = s if err >= 0.0 else s - (abs(s) * PHI + ETA)
+    return MAX if s == INF else r
 
 
 @_jit
 def _upper(s: float, err: float) -> float:
-    if s == -INF:
-        return -MAX
-    if err > 0.0:
-        return next_up(s)
-    return s
+    """Upper bound of the exact value (see ``_lower``); ``s = -inf`` gives ``-MAX``."""
+    r = s if err <= 0.0 else s + (abs(s) * PHI + ETA)
+    return -MAX if s == -INF else r
 
 
 @_jit
 def _two_sum_err(a: float, b: float, s: float) -> float:
+    """``a + b - s`` exactly (Knuth's TwoSum), for ``s = RN(a + b)``; NaN with infinities."""
     bb = s - a
     return (a - (s - bb)) + (b - bb)
 
@@ -143,113 +140,105 @@ def sub_up(a: float, b: float) -> float:
 
 @_jit
 def _mul_err(a: float, b: float, p: float) -> float:
-    """Sign-correct error of ``p = RN(a*b)``; +-inf when it cannot be trusted (underflow)."""
-    if abs(p) < TINY:
-        if a == 0.0 or b == 0.0:
-            return 0.0
-        return NAN
-    if abs(p) == INF:
-        return 0.0
-    return fma(a, b, -p)
+    """``a*b - p`` exactly (FMA) for ``p = RN(a*b)``; NaN (unknown) in the underflow range,
+    where the remainder itself may round."""
+    e = fma(a, b, -p)
+    return NAN if abs(p) < TINY else e
 
 
 @_jit
 def mul_dn(a: float, b: float) -> float:
-    """Lower bound of a*b with 0*inf = 0 (the interval convention)."""
-    if a == 0.0 or b == 0.0:
-        return 0.0
+    """Lower bound of a*b (tightest outside the underflow range), with 0*inf = 0."""
     p = a * b
-    e = _mul_err(a, b, p)
-    if e != e:  # underflow: step blindly, but the sign of a*b is known
-        r = next_down(p)
-        return max(r, 0.0) if (a > 0.0) == (b > 0.0) else r
-    return _lower(p, e)
+    r = _lower(p, _mul_err(a, b, p))
+    return 0.0 if (a == 0.0 or b == 0.0) else r
 
 
 @_jit
 def mul_up(a: float, b: float) -> float:
-    """Upper bound of a*b with 0*inf = 0."""
-    if a == 0.0 or b == 0.0:
-        return 0.0
+    """Upper bound of a*b (tightest outside the underflow range), with 0*inf = 0."""
     p = a * b
-    e = _mul_err(a, b, p)
-    if e != e:
-        r = next_up(p)
-        return min(r, 0.0) if (a > 0.0) != (b > 0.0) else r
-    return _upper(p, e)
+    r = _upper(p, _mul_err(a, b, p))
+    return 0.0 if (a == 0.0 or b == 0.0) else r
 
 
 @_jit
 def _div_err(a: float, b: float, q: float) -> float:
-    """Sign of ``a/b - q`` (exact), NaN when it cannot be decided cheaply."""
-    if abs(a) == INF or abs(b) == INF or (q == 0.0 and a == 0.0):
-        return 0.0
-    if abs(q) == INF:
-        return 0.0
-    if abs(q) < TINY or abs(a) < TINY:
-        return NAN
-    r = fma(-q, b, a)  # exact remainder a - q*b
-    return r if b > 0.0 else -r
+    """Sign of ``a/b - q`` for ``q = RN(a/b)``, ``b != 0``: the exact remainder ``a - q*b``
+    (FMA) times the sign of ``b``; NaN (unknown: step outward) in the underflow range and
+    with infinite operands, where ``_lower``/``_upper`` still give sound bounds."""
+    r = fma(-q, b, a)
+    e = r if b > 0.0 else -r
+    e = NAN if (abs(q) < TINY or abs(a) < TINY) else e
+    return 0.0 if a == 0.0 else e
 
 
 @_jit
 def div_dn(a: float, b: float) -> float:
     """Lower bound of a/b for b != 0 (limits at infinities: a/inf = 0, inf/b = inf)."""
     q = a / b
-    e = _div_err(a, b, q)
-    if e != e:
-        r = next_down(q)
-        return max(r, 0.0) if (a > 0.0) == (b > 0.0) else r
-    return _lower(q, e)
+    return _lower(q, _div_err(a, b, q))
 
 
 @_jit
 def div_up(a: float, b: float) -> float:
     """Upper bound of a/b for b != 0."""
     q = a / b
-    e = _div_err(a, b, q)
-    if e != e:
-        r = next_up(q)
-        return min(r, 0.0) if (a > 0.0) != (b > 0.0) else r
-    return _upper(q, e)
+    return _upper(q, _div_err(a, b, q))
+
+
+@_jit
+def _sqrt_err(a: float, s: float) -> float:
+    """``a - s*s`` exactly for ``s = RN(sqrt(a))`` (0 at 0 and inf, NaN when tiny)."""
+    e = fma(-s, s, a)
+    e = NAN if a < TINY else e
+    return 0.0 if (a == INF or a == 0.0) else e
 
 
 @_jit
 def sqrt_dn(a: float) -> float:
     """Lower bound of sqrt(a), a >= 0."""
     s = np.sqrt(a)
-    if a == INF or a == 0.0:
-        return s
-    if a < TINY:
-        return next_down(s)
-    return _lower(s, fma(-s, s, a))
+    r = _lower(s, _sqrt_err(a, s))
+    return r if r > 0.0 else 0.0  # (plain selects: Numba's max() blocks vectorisation)
 
 
 @_jit
 def sqrt_up(a: float) -> float:
     """Upper bound of sqrt(a), a >= 0."""
     s = np.sqrt(a)
-    if a == INF or a == 0.0:
-        return s
-    if a < TINY:
-        return next_up(s)
-    return _upper(s, fma(-s, s, a))
+    return _upper(s, _sqrt_err(a, s))
 
 
 @_jit
 def libm_dn(r: float) -> float:
     """Lower bound for a libm result ``r`` within ``LIBM_ULPS`` ulps of the exact value."""
-    if r == INF:
-        return MAX
-    return r - (abs(r) * _LIBM_REL + _LIBM_ABS)
+    d = r - (abs(r) * _LIBM_REL + _LIBM_ABS)
+    return MAX if r == INF else d
 
 
 @_jit
 def libm_up(r: float) -> float:
     """Upper bound for a libm result ``r`` within ``LIBM_ULPS`` ulps of the exact value."""
-    if r == -INF:
-        return -MAX
-    return r + (abs(r) * _LIBM_REL + _LIBM_ABS)
+    u = r + (abs(r) * _LIBM_REL + _LIBM_ABS)
+    return -MAX if r == -INF else u
+
+
+_ONE = 1.0
+_QUARTER_ULP = 2.0**-54
+
+
+def check_rounding_mode() -> None:
+    """Raise ``FloatingPointError`` unless the FPU rounds to nearest.
+
+    Every kernel assumes round-to-nearest; some libraries switch the process to upward
+    rounding (importing ``codac`` does), after which results would not be enclosures.
+    """
+    if _ONE + _QUARTER_ULP != _ONE or -_ONE - _QUARTER_ULP != -_ONE:
+        raise FloatingPointError(
+            "the floating-point rounding mode is not round-to-nearest (another library, e.g. "
+            "codac, changed it); boundest's enclosures need round-to-nearest: restore it "
+            "(fesetround(FE_TONEAREST)) before calling boundest")
 
 
 class _LazyGufunc:
@@ -260,6 +249,9 @@ class _LazyGufunc:
         self._nin = nin
         self._nout = nout
         self._ufunc = None
+        #: The element kernel as a Numba function ``f(a0, ..., out0, ...)`` for compiled
+        #: callers (outputs are 1-element array views); compiled on first use.
+        self.scalar = nb.njit(cache=True, error_model="numpy")(func)
         self.__name__ = func.__name__
         self.__doc__ = func.__doc__
 
@@ -271,8 +263,44 @@ class _LazyGufunc:
 
     def __call__(self, *args, **kwargs):
         ufunc = self._ufunc or self._build()
+        check_rounding_mode()
         with np.errstate(all="ignore"):  # overflow and inf - inf are expected inside kernels
             return ufunc(*args, **kwargs)
+
+
+class _LazyUfunc:
+    """A NumPy ufunc ``f(a0, ..., a_{nin-1}) -> float64`` compiled by Numba on first call.
+
+    Used for the branch-free kernels of ``+ - * / sqr sqrt``, one ufunc per bound: Numba's
+    vectorised loops run them with SIMD, several times faster than a gufunc per element.
+    """
+
+    def __init__(self, func: Callable, nin: int) -> None:
+        self._func = func
+        self._nin = nin
+        self._ufunc = None
+        #: The scalar kernel as a Numba function, for compiled callers.
+        self.scalar = nb.njit(cache=True, error_model="numpy")(func)
+        self.__name__ = func.__name__
+        self.__doc__ = func.__doc__
+
+    def _build(self):
+        sig = f"f8({','.join(['f8'] * self._nin)})"
+        self._ufunc = nb.vectorize([sig], cache=True)(self._func)
+        return self._ufunc
+
+    def __call__(self, *args, **kwargs):
+        ufunc = self._ufunc or self._build()
+        check_rounding_mode()
+        with np.errstate(all="ignore"):
+            return ufunc(*args, **kwargs)
+
+
+def ufunc(nin: int) -> Callable[[Callable], _LazyUfunc]:
+    """Declare a scalar kernel ``f(a0, ..., a_{nin-1}) -> float`` as a lazy NumPy ufunc."""
+    def wrap(func: Callable) -> _LazyUfunc:
+        return _LazyUfunc(func, nin)
+    return wrap
 
 
 def gufunc(nin: int, nout: int = 2) -> Callable[[Callable], _LazyGufunc]:
