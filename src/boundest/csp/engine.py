@@ -1,0 +1,283 @@
+"""The compiled propagation kernel: an AC3-style queue over the primitive nodes of a tape.
+
+Each node ``z = f(x, y)`` is revised by ``z ∩= f(x, y)`` then ``(x, y) = f_rev(z, x, y)``. When a
+slot's domain shrinks by more than ``rel_eps`` of its width (or loses an infinite bound), every
+other node using that slot is queued again. The queue is FIFO, initialised in tape order, so the
+first pass over a time-series model is a forward sweep and later passes follow the changes in both
+directions: the work per time step does not grow with the horizon.
+"""
+
+from __future__ import annotations
+
+import numba as nb
+import numpy as np
+
+from ..expr.tape import OPS
+from ..interval import algebraic as al
+from ..interval import arith as ar
+from ..interval import explog as el
+from ..interval import trig as tr
+
+__all__ = ["DONE", "EMPTY", "RUNNING", "propagate_kernel"]
+
+DONE, RUNNING, EMPTY = 0, 1, 2
+_C = {name: i for i, name in enumerate(OPS)}
+NEG, SQR, SQRT, EXP, LOG, SIN, COS, TAN = (_C[k] for k in
+                                           ("neg", "sqr", "sqrt", "exp", "log", "sin", "cos",
+                                            "tan"))
+ASIN, ACOS, ATAN, SINH, COSH, TANH, ABS, SIGN = (_C[k] for k in
+                                                 ("asin", "acos", "atan", "sinh", "cosh",
+                                                  "tanh", "abs", "sign"))
+FLOOR, CEIL, POWN, ADD, SUB, MUL, DIV, POW = (_C[k] for k in
+                                              ("floor", "ceil", "pown", "add", "sub", "mul",
+                                               "div", "pow"))
+ATAN2, MIN, MAX = _C["atan2"], _C["min"], _C["max"]
+
+_add_lo, _add_hi, _sub_lo, _sub_hi = (ar._add_lo.scalar, ar._add_hi.scalar, ar._sub_lo.scalar,
+                                      ar._sub_hi.scalar)
+_mul_lo, _mul_hi, _div_lo, _div_hi = (ar._mul_lo.scalar, ar._mul_hi.scalar, ar._div_lo.scalar,
+                                      ar._div_hi.scalar)
+_sqr_lo, _sqr_hi, _sqrt_lo, _sqrt_hi = (ar._sqr_lo.scalar, ar._sqr_hi.scalar,
+                                        ar._sqrt_lo.scalar, ar._sqrt_hi.scalar)
+_f_exp, _f_log, _f_sinh, _f_cosh = el._exp.scalar, el._log.scalar, el._sinh.scalar, el._cosh.scalar
+_f_tanh, _f_atan, _f_atan2, _f_pow = (el._tanh.scalar, el._atan.scalar, el._atan2.scalar,
+                                      el._pow.scalar)
+_f_sin, _f_cos, _f_tan, _f_asin, _f_acos = (tr._sin.scalar, tr._cos.scalar, tr._tan.scalar,
+                                            tr._asin.scalar, tr._acos.scalar)
+_f_abs, _f_sign, _f_floor, _f_ceil = (al._abs.scalar, al._sign.scalar, al._floor.scalar,
+                                      al._ceil.scalar)
+_f_pown, _f_min, _f_max = al._pown.scalar, al._min.scalar, al._max.scalar
+_b_neg, _b_sqr, _b_sqrt, _b_abs = (al._neg_rev.scalar, al._sqr_rev.scalar, al._sqrt_rev.scalar,
+                                   al._abs_rev.scalar)
+_b_sign, _b_floor, _b_ceil, _b_pown = (al._sign_rev.scalar, al._floor_rev.scalar,
+                                       al._ceil_rev.scalar, al._pown_rev.scalar)
+_b_add, _b_sub, _b_mul, _b_div = (al._add_rev.scalar, al._sub_rev.scalar, al._mul_rev.scalar,
+                                  al._div_rev.scalar)
+_b_min, _b_max = al._min_rev.scalar, al._max_rev.scalar
+_b_exp, _b_log, _b_sinh, _b_cosh = (el._exp_rev.scalar, el._log_rev.scalar, el._sinh_rev.scalar,
+                                    el._cosh_rev.scalar)
+_b_tanh, _b_atan, _b_atan2, _b_pow = (el._tanh_rev.scalar, el._atan_rev.scalar,
+                                      el._atan2_rev.scalar, el._pow_rev.scalar)
+_b_sin, _b_cos, _b_tan, _b_asin, _b_acos = (tr._sin_rev.scalar, tr._cos_rev.scalar,
+                                            tr._tan_rev.scalar, tr._asin_rev.scalar,
+                                            tr._acos_rev.scalar)
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _forward(code, xl, xh, yl, yh, p, buf):
+    """Image of node ``code`` into ``buf[0:2]``."""
+    o0, o1 = buf[0:1], buf[1:2]
+    if code == ADD:
+        buf[0] = _add_lo(xl, xh, yl, yh)
+        buf[1] = _add_hi(xl, xh, yl, yh)
+    elif code == SUB:
+        buf[0] = _sub_lo(xl, xh, yl, yh)
+        buf[1] = _sub_hi(xl, xh, yl, yh)
+    elif code == MUL:
+        buf[0] = _mul_lo(xl, xh, yl, yh)
+        buf[1] = _mul_hi(xl, xh, yl, yh)
+    elif code == DIV:
+        buf[0] = _div_lo(xl, xh, yl, yh)
+        buf[1] = _div_hi(xl, xh, yl, yh)
+    elif code == NEG:
+        buf[0] = -xh
+        buf[1] = -xl
+    elif code == SQR:
+        buf[0] = _sqr_lo(xl, xh)
+        buf[1] = _sqr_hi(xl, xh)
+    elif code == SQRT:
+        buf[0] = _sqrt_lo(xl, xh)
+        buf[1] = _sqrt_hi(xl, xh)
+    elif code == POWN:
+        _f_pown(xl, xh, np.int64(p), o0, o1)
+    elif code == EXP:
+        _f_exp(xl, xh, o0, o1)
+    elif code == LOG:
+        _f_log(xl, xh, o0, o1)
+    elif code == SIN:
+        _f_sin(xl, xh, o0, o1)
+    elif code == COS:
+        _f_cos(xl, xh, o0, o1)
+    elif code == TAN:
+        _f_tan(xl, xh, o0, o1)
+    elif code == ASIN:
+        _f_asin(xl, xh, o0, o1)
+    elif code == ACOS:
+        _f_acos(xl, xh, o0, o1)
+    elif code == ATAN:
+        _f_atan(xl, xh, o0, o1)
+    elif code == SINH:
+        _f_sinh(xl, xh, o0, o1)
+    elif code == COSH:
+        _f_cosh(xl, xh, o0, o1)
+    elif code == TANH:
+        _f_tanh(xl, xh, o0, o1)
+    elif code == ABS:
+        _f_abs(xl, xh, o0, o1)
+    elif code == SIGN:
+        _f_sign(xl, xh, o0, o1)
+    elif code == FLOOR:
+        _f_floor(xl, xh, o0, o1)
+    elif code == CEIL:
+        _f_ceil(xl, xh, o0, o1)
+    elif code == POW:
+        _f_pow(xl, xh, yl, yh, o0, o1)
+    elif code == ATAN2:
+        _f_atan2(xl, xh, yl, yh, o0, o1)
+    elif code == MIN:
+        _f_min(xl, xh, yl, yh, o0, o1)
+    else:  # MAX
+        _f_max(xl, xh, yl, yh, o0, o1)
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _backward(code, zl, zh, xl, xh, yl, yh, p, buf):
+    """Projections of node ``code`` into ``buf[0:2]`` (x) and ``buf[2:4]`` (y)."""
+    o0, o1, o2, o3 = buf[0:1], buf[1:2], buf[2:3], buf[3:4]
+    if code == ADD:
+        _b_add(zl, zh, xl, xh, yl, yh, o0, o1, o2, o3)
+    elif code == SUB:
+        _b_sub(zl, zh, xl, xh, yl, yh, o0, o1, o2, o3)
+    elif code == MUL:
+        _b_mul(zl, zh, xl, xh, yl, yh, o0, o1, o2, o3)
+    elif code == DIV:
+        _b_div(zl, zh, xl, xh, yl, yh, o0, o1, o2, o3)
+    elif code == POW:
+        _b_pow(zl, zh, xl, xh, yl, yh, o0, o1, o2, o3)
+    elif code == ATAN2:
+        _b_atan2(zl, zh, xl, xh, yl, yh, o0, o1, o2, o3)
+    elif code == MIN:
+        _b_min(zl, zh, xl, xh, yl, yh, o0, o1, o2, o3)
+    elif code == MAX:
+        _b_max(zl, zh, xl, xh, yl, yh, o0, o1, o2, o3)
+    elif code == NEG:
+        _b_neg(zl, zh, xl, xh, o0, o1)
+    elif code == SQR:
+        _b_sqr(zl, zh, xl, xh, o0, o1)
+    elif code == SQRT:
+        _b_sqrt(zl, zh, xl, xh, o0, o1)
+    elif code == POWN:
+        _b_pown(zl, zh, xl, xh, np.int64(p), o0, o1)
+    elif code == EXP:
+        _b_exp(zl, zh, xl, xh, o0, o1)
+    elif code == LOG:
+        _b_log(zl, zh, xl, xh, o0, o1)
+    elif code == SIN:
+        _b_sin(zl, zh, xl, xh, o0, o1)
+    elif code == COS:
+        _b_cos(zl, zh, xl, xh, o0, o1)
+    elif code == TAN:
+        _b_tan(zl, zh, xl, xh, o0, o1)
+    elif code == ASIN:
+        _b_asin(zl, zh, xl, xh, o0, o1)
+    elif code == ACOS:
+        _b_acos(zl, zh, xl, xh, o0, o1)
+    elif code == ATAN:
+        _b_atan(zl, zh, xl, xh, o0, o1)
+    elif code == SINH:
+        _b_sinh(zl, zh, xl, xh, o0, o1)
+    elif code == COSH:
+        _b_cosh(zl, zh, xl, xh, o0, o1)
+    elif code == TANH:
+        _b_tanh(zl, zh, xl, xh, o0, o1)
+    elif code == ABS:
+        _b_abs(zl, zh, xl, xh, o0, o1)
+    elif code == SIGN:
+        _b_sign(zl, zh, xl, xh, o0, o1)
+    elif code == FLOOR:
+        _b_floor(zl, zh, xl, xh, o0, o1)
+    else:  # CEIL
+        _b_ceil(zl, zh, xl, xh, o0, o1)
+
+
+@nb.njit(cache=True, inline="always", error_model="numpy")
+def _significant(ol, oh, nl, nh, rel_eps):
+    """Whether ``[ol, oh] -> [nl, nh]`` is a shrink worth propagating."""
+    if nl == ol and nh == oh:
+        return False
+    w0 = oh - ol
+    if w0 == np.inf:
+        return True  # a bound became finite or moved: cheap to propagate, often decisive
+    return (w0 - (nh - nl)) > rel_eps * w0
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _update(s, nl, nh, lo, hi, rel_eps):
+    """Intersect slot ``s`` with ``[nl, nh]``: -1 empty, 1 significant shrink, 0 otherwise."""
+    ol, oh = lo[s], hi[s]
+    nl = max(nl, ol) if nl == nl else nl  # NaN (empty) must survive the max
+    nh = min(nh, oh) if nh == nh else nh
+    if nl != nl or nh != nh or nl > nh:
+        lo[s] = np.nan
+        hi[s] = np.nan
+        return -1
+    sig = _significant(ol, oh, nl, nh, rel_eps)
+    lo[s] = nl
+    hi[s] = nh
+    return 1 if sig else 0
+
+
+@nb.njit(cache=True, error_model="numpy")
+def propagate_kernel(op, out, a, b, param, lo, hi, ptr, adj, queue, inq, state, rel_eps,
+                     max_evals):
+    """Run the queue for at most ``max_evals`` node revisions.
+
+    ``state = [head, count, status, evals_total]`` is read and written so that a long run can be
+    continued in chunks (for progress reports). ``ptr``/``adj`` list, for each slot, the nodes
+    using it (CSR). Returns the status (DONE, RUNNING or EMPTY).
+    """
+    n = op.size
+    head, count, evals = state[0], state[1], 0
+    buf = np.empty(4)
+    changed = np.empty(3, dtype=np.int64)
+    status = RUNNING
+    while count > 0 and evals < max_evals:
+        i = queue[head]
+        head = head + 1 if head + 1 < n else 0
+        count -= 1
+        inq[i] = False
+        evals += 1
+        code, o, ia, ib = op[i], out[i], a[i], b[i]
+        xl, xh = lo[ia], hi[ia]
+        yl, yh = (lo[ib], hi[ib]) if ib >= 0 else (0.0, 0.0)
+        _forward(code, xl, xh, yl, yh, param[i], buf)
+        nch = 0
+        r = _update(o, buf[0], buf[1], lo, hi, rel_eps)
+        if r < 0:
+            status = EMPTY
+            break
+        if r > 0:
+            changed[nch] = o
+            nch += 1
+        xl, xh = lo[ia], hi[ia]  # o may alias an argument
+        if ib >= 0:
+            yl, yh = lo[ib], hi[ib]
+        _backward(code, lo[o], hi[o], xl, xh, yl, yh, param[i], buf)
+        r = _update(ia, buf[0], buf[1], lo, hi, rel_eps)
+        if r < 0:
+            status = EMPTY
+            break
+        if r > 0:
+            changed[nch] = ia
+            nch += 1
+        if ib >= 0:
+            r = _update(ib, buf[2], buf[3], lo, hi, rel_eps)
+            if r < 0:
+                status = EMPTY
+                break
+            if r > 0:
+                changed[nch] = ib
+                nch += 1
+        for c in range(nch):
+            s = changed[c]
+            for k in range(ptr[s], ptr[s + 1]):
+                j = adj[k]
+                if j != i and not inq[j]:
+                    inq[j] = True
+                    tail = head + count
+                    queue[tail if tail < n else tail - n] = j
+                    count += 1
+    if status != EMPTY and count == 0:
+        status = DONE
+    state[0], state[1], state[2], state[3] = head, count, status, state[3] + evals
+    return status

@@ -1,0 +1,58 @@
+"""A model: variables with their initial domains and a list of constraints."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+
+from ..interval import Interval
+from .nodes import Constraint, Var, variables
+
+__all__ = ["Model"]
+
+
+@dataclass
+class Model:
+    """Variables (name -> scalar interval domain) and constraints over them.
+
+    Variables used by a constraint but not declared get the entire line as domain.
+    ``options`` keeps header lines of a model file (e.g. RealPaver's ``Bisection none;``).
+    """
+
+    domains: dict[str, Interval] = field(default_factory=dict)
+    constraints: list[Constraint] = field(default_factory=list)
+    options: dict[str, str] = field(default_factory=dict)
+
+    def declare(self, var: Var | str, domain: Interval | tuple[float, float] | None = None
+                ) -> Var:
+        """Declare a variable with a domain (entire line by default); returns the ``Var``."""
+        v = var if isinstance(var, Var) else Var(var)
+        dom = Interval.entire() if domain is None else (
+            domain if isinstance(domain, Interval) else Interval(*domain))
+        if dom.shape != ():
+            raise ValueError(f"domain of {v.name} must be a scalar interval, got {dom}")
+        self.domains[v.name] = dom
+        return v
+
+    def add(self, *constraints: Constraint | Iterable[Constraint]) -> Model:
+        """Add constraints (or iterables of them); returns the model for chaining."""
+        for c in constraints:
+            if isinstance(c, Constraint):
+                self.constraints.append(c)
+            else:
+                for ci in c:
+                    if not isinstance(ci, Constraint):
+                        raise TypeError(f"not a constraint: {ci!r}")
+                    self.constraints.append(ci)
+        return self
+
+    def variable_names(self) -> list[str]:
+        """Declared variables first (in declaration order), then undeclared ones."""
+        names = list(self.domains)
+        known = set(names)
+        names += [v.name for v in variables(self.constraints) if v.name not in known]
+        return names
+
+    def __repr__(self) -> str:
+        return (f"Model({len(self.variable_names())} variables, "
+                f"{len(self.constraints)} constraints)")

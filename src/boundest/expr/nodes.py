@@ -1,0 +1,253 @@
+"""Symbolic expressions and constraints built by operator overloading.
+
+>>> x1, x3, w1 = Var.family("x1"), Var.family("x3"), Var.family("w1")
+>>> c = x1[1] == x1[0] + 0.5 * x3[0] + w1[0]
+>>> str(c)
+'x1_1 == x1_0 + 0.5 * x3_0 + w1_0'
+
+Expressions are immutable trees; the compiler (``tape.py``) shares equal sub-expressions.
+"""
+
+from __future__ import annotations
+
+import numbers
+from collections.abc import Iterable
+
+from ..interval import Interval, as_interval
+
+__all__ = [
+    "BINARY",
+    "UNARY",
+    "Const",
+    "Constraint",
+    "Expr",
+    "Op",
+    "Var",
+    "VarFamily",
+    "as_expr",
+    "variables",
+]
+
+#: Unary primitives (name -> infix/func display) understood by the compiler.
+UNARY = ("neg", "sqr", "sqrt", "exp", "log", "sin", "cos", "tan", "asin", "acos", "atan",
+         "sinh", "cosh", "tanh", "abs", "sign", "floor", "ceil", "pown")
+#: Binary primitives.
+BINARY = ("add", "sub", "mul", "div", "pow", "atan2", "min", "max")
+_INFIX = {"add": ("+", 1), "sub": ("-", 1), "mul": ("*", 2), "div": ("/", 2)}
+
+
+class Expr:
+    """Base class of expression nodes; arithmetic operators build new nodes."""
+
+    __slots__ = ()
+    __array_ufunc__ = None
+    __hash__ = object.__hash__  # == builds a constraint, so hashing is by identity
+
+    # arithmetic
+    def __add__(self, o: object) -> Expr:
+        return Op("add", (self, as_expr(o)))
+
+    def __radd__(self, o: object) -> Expr:
+        return Op("add", (as_expr(o), self))
+
+    def __sub__(self, o: object) -> Expr:
+        return Op("sub", (self, as_expr(o)))
+
+    def __rsub__(self, o: object) -> Expr:
+        return Op("sub", (as_expr(o), self))
+
+    def __mul__(self, o: object) -> Expr:
+        return Op("mul", (self, as_expr(o)))
+
+    def __rmul__(self, o: object) -> Expr:
+        return Op("mul", (as_expr(o), self))
+
+    def __truediv__(self, o: object) -> Expr:
+        return Op("div", (self, as_expr(o)))
+
+    def __rtruediv__(self, o: object) -> Expr:
+        return Op("div", (as_expr(o), self))
+
+    def __neg__(self) -> Expr:
+        return Op("neg", (self,))
+
+    def __pos__(self) -> Expr:
+        return self
+
+    def __pow__(self, o: object) -> Expr:
+        if isinstance(o, numbers.Integral) and not isinstance(o, bool):
+            return Op("sqr", (self,)) if int(o) == 2 else Op("pown", (self,), int(o))
+        return Op("pow", (self, as_expr(o)))
+
+    def __rpow__(self, o: object) -> Expr:
+        return Op("pow", (as_expr(o), self))
+
+    def __abs__(self) -> Expr:
+        return Op("abs", (self,))
+
+    # constraints
+    def __eq__(self, o: object) -> Constraint:  # type: ignore[override]
+        return Constraint(self, "==", as_expr(o))
+
+    def __le__(self, o: object) -> Constraint:
+        return Constraint(self, "<=", as_expr(o))
+
+    def __ge__(self, o: object) -> Constraint:
+        return Constraint(self, ">=", as_expr(o))
+
+    def in_(self, domain: Interval | tuple[float, float] | list[float]) -> Constraint:
+        """The constraint ``self in domain`` (Python's ``in`` cannot return a constraint)."""
+        if not isinstance(domain, Interval):
+            domain = Interval(*domain)
+        if domain.shape != ():
+            raise ValueError(f"in_() needs a scalar interval, got shape {domain.shape}")
+        return Constraint(self, "in", Const(domain))
+
+    def __bool__(self) -> bool:
+        raise TypeError("an expression has no truth value (did you compare two expressions "
+                        "outside a constraint?)")
+
+    def __repr__(self) -> str:
+        return f"Expr({self})"
+
+
+class Const(Expr):
+    """A constant, held as a scalar interval (a decimal literal is its outward enclosure)."""
+
+    __slots__ = ("value",)
+
+    def __init__(self, value: Interval | float) -> None:
+        v = as_interval(value)
+        if v.shape != ():
+            raise ValueError(f"a constant must be a scalar, got shape {v.shape}")
+        self.value = v
+
+    def __str__(self) -> str:
+        lo, hi = float(self.value.lo), float(self.value.hi)
+        return f"{lo:g}" if lo == hi else f"[{lo!r}, {hi!r}]"
+
+
+class Var(Expr):
+    """A named real variable. ``Var.family("x")[k]`` is the variable ``x_k``."""
+
+    __slots__ = ("name",)
+
+    def __init__(self, name: str) -> None:
+        if not isinstance(name, str) or not name.isidentifier():
+            raise ValueError(f"invalid variable name: {name!r}")
+        self.name = name
+
+    def __str__(self) -> str:
+        return self.name
+
+    @staticmethod
+    def family(name: str) -> VarFamily:
+        return VarFamily(name)
+
+
+class VarFamily:
+    """An indexed family of variables: ``x[k]`` is the variable named ``x_k``.
+
+    The same index gives the same ``Var`` object; multi-indices join with ``_``.
+    """
+
+    def __init__(self, name: str) -> None:
+        if not name.isidentifier():
+            raise ValueError(f"invalid variable family name: {name!r}")
+        self.name = name
+        self._members: dict[tuple[int, ...], Var] = {}
+
+    def __getitem__(self, k: int | tuple[int, ...]) -> Var:
+        key = k if isinstance(k, tuple) else (k,)
+        for i in key:
+            if not isinstance(i, numbers.Integral) or i < 0:
+                raise IndexError(f"{self.name}[{k}]: indices must be non-negative integers")
+        var = self._members.get(key)
+        if var is None:
+            var = Var(self.name + "".join(f"_{int(i)}" for i in key))
+            self._members[key] = var
+        return var
+
+    def __repr__(self) -> str:
+        return f"VarFamily({self.name!r})"
+
+
+class Op(Expr):
+    """An operation node: ``name`` is one of ``UNARY + BINARY``; ``param`` is pown's exponent."""
+
+    __slots__ = ("args", "name", "param")
+
+    def __init__(self, name: str, args: tuple[Expr, ...], param: int | None = None) -> None:
+        arity = 1 if name in UNARY else 2 if name in BINARY else None
+        if arity is None:
+            raise ValueError(f"unknown operation {name!r}")
+        if len(args) != arity:
+            raise ValueError(f"{name} takes {arity} argument(s), got {len(args)}")
+        self.name, self.args, self.param = name, args, param
+
+    def __str__(self) -> str:
+        if self.name in _INFIX:
+            sym, prec = _INFIX[self.name]
+            a, b = (_paren(arg, prec, right=i == 1) for i, arg in enumerate(self.args))
+            return f"{a} {sym} {b}"
+        if self.name == "neg":
+            return f"-{_paren(self.args[0], 3)}"
+        if self.name == "sqr":
+            return f"{_paren(self.args[0], 4)}^2"
+        if self.name == "pown":
+            return f"{_paren(self.args[0], 4)}^{self.param}"
+        return f"{self.name}({', '.join(str(a) for a in self.args)})"
+
+
+def _paren(e: Expr, prec: int, right: bool = False) -> str:
+    if isinstance(e, Op):
+        p = _INFIX.get(e.name, (None, 5 if e.name not in ("neg",) else 3))[1]
+        if p < prec or (right and p == prec):
+            return f"({e})"
+    elif isinstance(e, Const) and float(e.value.lo) < 0:
+        return f"({e})"
+    return str(e)
+
+
+class Constraint:
+    """``lhs rel rhs`` with ``rel`` one of ``==``, ``<=``, ``>=``, ``in`` (rhs a constant)."""
+
+    __slots__ = ("lhs", "rel", "rhs")
+
+    def __init__(self, lhs: Expr, rel: str, rhs: Expr) -> None:
+        if rel not in ("==", "<=", ">=", "in"):
+            raise ValueError(f"unknown relation {rel!r}")
+        self.lhs, self.rel, self.rhs = lhs, rel, rhs
+
+    def __str__(self) -> str:
+        return f"{self.lhs} {self.rel} {self.rhs}"
+
+    def __repr__(self) -> str:
+        return f"Constraint({self})"
+
+    def __bool__(self) -> bool:
+        raise TypeError("a constraint has no truth value; add it to a model instead")
+
+
+def as_expr(x: object) -> Expr:
+    """``x`` itself for an expression, else a constant (numbers and scalar intervals)."""
+    if isinstance(x, Expr):
+        return x
+    if isinstance(x, (Interval, numbers.Real)):
+        return Const(x)  # type: ignore[arg-type]
+    raise TypeError(f"cannot use {type(x).__name__} {x!r} in an expression")
+
+
+def variables(items: Iterable[Expr | Constraint]) -> list[Var]:
+    """The distinct variables of expressions/constraints, in order of first appearance."""
+    seen: dict[str, Var] = {}
+    stack: list[Expr] = []
+    for it in items:
+        stack.extend([it.rhs, it.lhs] if isinstance(it, Constraint) else [it])
+        while stack:
+            e = stack.pop()
+            if isinstance(e, Var):
+                seen.setdefault(e.name, e)
+            elif isinstance(e, Op):
+                stack.extend(reversed(e.args))
+    return list(seen.values())

@@ -1,0 +1,253 @@
+"""The model text format (close to RealPaver's), parsed with a Lark LALR grammar.
+
+Grammar (EBNF; the authoritative copy is ``GRAMMAR`` below)::
+
+    model       := option* ["Variables"] declaration ("," declaration)* ";"
+                   "Constraints" constraint ("," constraint)* ";"
+    option      := NAME (NAME | NUMBER) ";"              e.g.  Bisection none;
+    declaration := NAME "in" domain                      e.g.  x1_0 in [0, +oo[
+    domain      := ("[" | "]") bound "," bound ("]" | "[")
+    bound       := ["+" | "-"] (NUMBER | "oo")
+    constraint  := expr ("=" | "<=" | ">=") expr  |  expr "in" domain
+    expr        := term (("+" | "-") term)*
+    term        := factor (("*" | "/") factor)*
+    factor      := "-" factor | power
+    power       := atom ["^" factor]         (an integer constant exponent gives pown)
+    atom        := NUMBER | NAME | NAME "(" expr ("," expr)* ")" | "(" expr ")"
+
+Comments run from ``//`` or ``#`` to the end of the line. A bracket written open (``]0, 1]``)
+is read as closed: float intervals are closed, so this is a sound relaxation. A decimal literal
+such as ``0.1`` denotes the exact decimal and becomes the tightest float interval enclosing it.
+Functions: sqrt exp log sin cos tan asin acos atan sinh cosh tanh abs sign floor ceil (one
+argument), atan2 min max pow (two). ``x^2`` is ``sqr``, ``x^n`` with an integer ``n`` is ``pown``,
+any other exponent is ``pow`` (defined for x >= 0).
+"""
+
+from __future__ import annotations
+
+from fractions import Fraction
+from pathlib import Path
+
+import numpy as np
+from lark import Lark, Token, Transformer, v_args
+from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, VisitError
+
+from ..interval import Interval
+from .model import Model
+from .nodes import Const, Constraint, Op, Var
+
+__all__ = ["GRAMMAR", "ModelSyntaxError", "decimal_interval", "load_model", "parse_model"]
+
+GRAMMAR = r"""
+start: option* _VARIABLES? decl ("," decl)* ";" _CONSTRAINTS constraint ("," constraint)* ";"
+option: NAME (NAME | NUMBER) ";"
+decl: NAME _IN domain
+domain: LB bound "," bound RB
+!bound: ("+" | "-")? (NUMBER | INF)
+?constraint: expr "=" expr   -> eq
+           | expr "<=" expr  -> le
+           | expr ">=" expr  -> ge
+           | expr _IN domain -> within
+?expr: term
+     | expr "+" term -> add
+     | expr "-" term -> sub
+?term: factor
+     | term "*" factor -> mul
+     | term "/" factor -> div
+?factor: power
+       | "-" factor -> neg
+?power: atom
+      | atom "^" factor -> power
+?atom: NUMBER -> number
+     | NAME -> name
+     | NAME "(" expr ("," expr)* ")" -> call
+     | "(" expr ")"
+LB: "[" | "]"
+RB: "]" | "["
+INF: "oo"
+_IN: "in"
+_VARIABLES.2: /variables\b/i
+_CONSTRAINTS.2: /constraints\b/i
+NUMBER: /([0-9]+\.[0-9]*|\.[0-9]+|[0-9]+)([eE][+-]?[0-9]+)?/
+NAME: /(?!oo\b|in\b)[A-Za-z_][A-Za-z0-9_]*/
+COMMENT: /(\/\/|#)[^\n]*/
+%import common.WS
+%ignore WS
+%ignore COMMENT
+"""
+
+_UNARY_FUNCS = {"sqrt", "exp", "log", "sin", "cos", "tan", "asin", "acos", "atan", "sinh",
+                "cosh", "tanh", "abs", "sign", "floor", "ceil"}
+_BINARY_FUNCS = {"atan2", "min", "max", "pow"}
+
+_parser = Lark(GRAMMAR, parser="lalr", propagate_positions=True, maybe_placeholders=False)
+
+
+class ModelSyntaxError(ValueError):
+    """A malformed model file; the message names the file, line and column."""
+
+
+def decimal_interval(text: str) -> Interval:
+    """The tightest float interval containing the decimal number written in ``text``."""
+    exact = Fraction(text)
+    f = float(text)
+    if not np.isfinite(f):
+        raise ValueError(f"number out of float64 range: {text}")
+    if Fraction(f) == exact:
+        return Interval(f)
+    if Fraction(f) < exact:
+        return Interval(f, np.nextafter(f, np.inf))
+    return Interval(np.nextafter(f, -np.inf), f)
+
+
+class _Build(Transformer):
+    def __init__(self, source: str) -> None:
+        super().__init__()
+        self.source = source
+        self.model = Model()
+        self.vars: dict[str, Var] = {}
+
+    def _err(self, tok: Token, msg: str) -> ModelSyntaxError:
+        return ModelSyntaxError(f"{self.source}:{tok.line}:{tok.column}: {msg}")
+
+    # header and declarations
+    def option(self, items):
+        key, value = items
+        self.model.options[str(key)] = str(value)
+
+    def bound(self, items):
+        sign = -1.0 if str(items[0]) == "-" else 1.0
+        tok = items[-1]
+        if tok.type == "INF":
+            return (tok, sign * np.inf, None)
+        iv = decimal_interval(str(tok))
+        return (tok, float(iv.lo) if sign > 0 else -float(iv.hi),
+                float(iv.hi) if sign > 0 else -float(iv.lo))
+
+    def domain(self, items):
+        lb, (tok_a, a_lo, _), (tok_b, b_lo, b_hi), _rb = items
+        lo = a_lo
+        hi = b_lo if b_hi is None else b_hi
+        if lo == np.inf or hi == -np.inf or lo > hi:
+            raise self._err(lb, f"invalid domain [{tok_a}, {tok_b}]: lower bound above upper "
+                                "bound or infinite on the wrong side")
+        return Interval(lo, hi)
+
+    def decl(self, items):
+        name, dom = items
+        if str(name) in self.vars:
+            raise self._err(name, f"variable {name} declared twice")
+        self.vars[str(name)] = self.model.declare(str(name), dom)
+
+    # expressions
+    def number(self, items):
+        return Const(decimal_interval(str(items[0])))
+
+    def name(self, items):
+        tok = items[0]
+        var = self.vars.get(str(tok))
+        if var is None:
+            raise self._err(tok, f"unknown variable {tok} (declare it with '{tok} in [a, b]')")
+        return var
+
+    def call(self, items):
+        fname, args = items[0], items[1:]
+        f = str(fname)
+        if f in _UNARY_FUNCS:
+            if len(args) != 1:
+                raise self._err(fname, f"{f} takes one argument, got {len(args)}")
+            return Op(f, (args[0],))
+        if f in _BINARY_FUNCS:
+            if len(args) != 2:
+                raise self._err(fname, f"{f} takes two arguments, got {len(args)}")
+            return Op(f, (args[0], args[1]))
+        raise self._err(fname, f"unknown function {f}")
+
+    @v_args(inline=True)
+    def add(self, a, b):
+        return a + b
+
+    @v_args(inline=True)
+    def sub(self, a, b):
+        return a - b
+
+    @v_args(inline=True)
+    def mul(self, a, b):
+        return a * b
+
+    @v_args(inline=True)
+    def div(self, a, b):
+        return a / b
+
+    @v_args(inline=True)
+    def neg(self, a):
+        if isinstance(a, Const):
+            return Const(-a.value)
+        return -a
+
+    @v_args(inline=True)
+    def power(self, base, e):
+        if isinstance(e, Const) and float(e.value.lo) == float(e.value.hi):
+            n = float(e.value.lo)
+            if n.is_integer() and abs(n) < 2**31:
+                return base ** int(n)
+        return Op("pow", (base, e))
+
+    # constraints
+    @v_args(inline=True)
+    def eq(self, a, b):
+        return Constraint(a, "==", b)
+
+    @v_args(inline=True)
+    def le(self, a, b):
+        return Constraint(a, "<=", b)
+
+    @v_args(inline=True)
+    def ge(self, a, b):
+        return Constraint(a, ">=", b)
+
+    @v_args(inline=True)
+    def within(self, a, dom):
+        return Constraint(a, "in", Const(dom))
+
+    def start(self, items):
+        self.model.add(c for c in items if isinstance(c, Constraint))
+        return self.model
+
+
+def parse_model(text: str, source: str = "<string>") -> Model:
+    """Parse model text into a ``Model``; errors name ``source``, line and column."""
+    try:
+        tree = _parser.parse(text)
+    except UnexpectedEOF as exc:
+        lines = text.rstrip().splitlines() or [""]
+        raise ModelSyntaxError(f"{source}:{len(lines)}:{len(lines[-1]) + 1}: unexpected end "
+                               f"of file (expected one of {sorted(exc.expected)})") from None
+    except UnexpectedCharacters as exc:
+        raise ModelSyntaxError(f"{source}:{exc.line}:{exc.column}: unexpected character "
+                               f"{text[exc.pos_in_stream]!r}") from None
+    except UnexpectedInput as exc:
+        tok = getattr(exc, "token", None)
+        what = f"unexpected {tok!s}" if tok is not None else "syntax error"
+        expected = getattr(exc, "expected", None) or getattr(exc, "accepts", None)
+        hint = f" (expected one of {sorted(expected)})" if expected else ""
+        raise ModelSyntaxError(f"{source}:{exc.line}:{exc.column}: {what}{hint}") from None
+    try:
+        return _Build(source).transform(tree)
+    except VisitError as exc:
+        if isinstance(exc.orig_exc, ValueError):
+            raise (exc.orig_exc if isinstance(exc.orig_exc, ModelSyntaxError)
+                   else ModelSyntaxError(f"{source}: {exc.orig_exc}")) from None
+        raise
+
+
+def load_model(path: str | Path) -> Model:
+    """Read and parse a model file."""
+    p = Path(path)
+    try:
+        text = p.read_text()
+    except OSError as exc:
+        raise ValueError(f"cannot read model file {p}: {exc.strerror}") from None
+    return parse_model(text, source=str(p))
+
+

@@ -1,0 +1,212 @@
+"""Compilation of constraints to a tape of primitive operations.
+
+Every distinct sub-expression becomes one *slot* (hash-consing, so shared sub-expressions are
+computed once, also across constraints) and one *node* ``out = op(a, b)``. An equality
+``lhs == rhs`` merges the two sides' slots (union-find), and merging may make two nodes
+identical, which are then merged too (congruence closure). Inequalities and ``in`` constraints
+become initial domains of slots. The result is the classic decomposition of a CSP into
+primitive constraints (seed 000 section 5, seed 004 section 6.4).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..interval import Interval
+from .model import Model
+from .nodes import BINARY, UNARY, Const, Constraint, Expr, Op, Var
+
+__all__ = ["OPS", "Tape", "compile_model"]
+
+#: Op codes: the index of a primitive's name in this tuple.
+OPS: tuple[str, ...] = UNARY + BINARY
+_CODE = {name: i for i, name in enumerate(OPS)}
+
+
+@dataclass
+class Tape:
+    """A CSP decomposed into primitive constraints over slots.
+
+    Attributes
+    ----------
+    lo, hi : (n_slots,) float64
+        Initial domains of the slots (variables first, then constants and intermediates).
+    slot_of : dict
+        Variable name -> slot (two variables merged by an equality share a slot).
+    op, out, a, b : (n_nodes,) int32
+        Node ``i`` is the primitive constraint ``slot out[i] = OPS[op[i]](slot a[i], slot b[i])``
+        (``b[i] = -1`` for unary ops). Nodes are in an order where, before merging, every
+        input was produced earlier (forward order).
+    param : (n_nodes,) float64
+        Integer exponent of ``pown`` nodes (0 elsewhere).
+    """
+
+    lo: NDArray[np.float64]
+    hi: NDArray[np.float64]
+    slot_of: dict[str, int]
+    op: NDArray[np.int32]
+    out: NDArray[np.int32]
+    a: NDArray[np.int32]
+    b: NDArray[np.int32]
+    param: NDArray[np.float64]
+
+    @property
+    def n_slots(self) -> int:
+        return len(self.lo)
+
+    @property
+    def n_nodes(self) -> int:
+        return len(self.op)
+
+    def domains(self) -> Interval:
+        """The initial domains of all slots."""
+        return Interval._new(self.lo.copy(), self.hi.copy())
+
+    def describe(self) -> str:
+        names = {s: n for n, s in self.slot_of.items()}
+        lines = []
+        for i in range(self.n_nodes):
+            args = [names.get(int(s), f"t{int(s)}") for s in (self.a[i], self.b[i]) if s >= 0]
+            p = f", {int(self.param[i])}" if OPS[self.op[i]] == "pown" else ""
+            out = names.get(int(self.out[i]), f"t{int(self.out[i])}")
+            lines.append(f"{out} = {OPS[self.op[i]]}({', '.join(args)}{p})")
+        return "\n".join(lines)
+
+
+class _Builder:
+    def __init__(self) -> None:
+        self.lo: list[float] = []
+        self.hi: list[float] = []
+        self.slot_of: dict[str, int] = {}
+        self.const_slot: dict[tuple[float, float], int] = {}
+        self.node_of: dict[tuple, int] = {}
+        self.nodes: list[tuple[int, int, int, int, float]] = []  # (op, out, a, b, param)
+        self.memo: dict[int, int] = {}  # id(expr) -> slot, for trees reused by identity
+        self.keep: list[Expr] = []  # keep memoised expressions alive (ids stay unique)
+
+    def new_slot(self, lo: float = -np.inf, hi: float = np.inf) -> int:
+        self.lo.append(lo)
+        self.hi.append(hi)
+        return len(self.lo) - 1
+
+    def var(self, name: str) -> int:
+        s = self.slot_of.get(name)
+        if s is None:
+            s = self.slot_of[name] = self.new_slot()
+        return s
+
+    def expr(self, e: Expr) -> int:
+        s = self.memo.get(id(e))
+        if s is not None:
+            return s
+        if isinstance(e, Var):
+            s = self.var(e.name)
+        elif isinstance(e, Const):
+            key = (float(e.value.lo), float(e.value.hi))
+            s = self.const_slot.get(key)
+            if s is None:
+                s = self.const_slot[key] = self.new_slot(*key)
+        elif isinstance(e, Op):
+            args = [self.expr(x) for x in e.args]
+            a, b = args[0], (args[1] if len(args) == 2 else -1)
+            param = float(e.param) if e.param is not None else 0.0
+            key = (_CODE[e.name], a, b, param)
+            node = self.node_of.get(key)
+            if node is None:
+                s = self.new_slot()
+                self.node_of[key] = len(self.nodes)
+                self.nodes.append((key[0], s, a, b, param))
+            else:
+                s = self.nodes[node][1]
+        else:
+            raise TypeError(f"not an expression: {e!r}")
+        self.memo[id(e)] = s
+        self.keep.append(e)
+        return s
+
+    def restrict(self, s: int, lo: float, hi: float) -> None:
+        self.lo[s] = max(self.lo[s], lo)
+        self.hi[s] = min(self.hi[s], hi)
+
+
+def _find(parent: list[int], s: int) -> int:
+    while parent[s] != s:
+        parent[s] = parent[parent[s]]
+        s = parent[s]
+    return s
+
+
+def compile_model(model: Model | list[Constraint], domains: dict[str, Interval] | None = None
+                  ) -> Tape:
+    """Decompose a model (or a list of constraints) into a ``Tape``."""
+    if not isinstance(model, Model):
+        model = Model(domains=dict(domains or {}), constraints=list(model))
+    bld = _Builder()
+    for name in model.variable_names():
+        bld.var(name)
+    for name, dom in model.domains.items():
+        bld.restrict(bld.slot_of[name], float(dom.lo), float(dom.hi))
+    merges: list[tuple[int, int]] = []
+    for c in model.constraints:
+        if c.rel == "in":
+            assert isinstance(c.rhs, Const)
+            bld.restrict(bld.expr(c.lhs), float(c.rhs.value.lo), float(c.rhs.value.hi))
+        elif c.rel == "==":
+            merges.append((bld.expr(c.lhs), bld.expr(c.rhs)))
+        else:
+            lhs, rhs = (c.lhs, c.rhs) if c.rel == "<=" else (c.rhs, c.lhs)  # lhs <= rhs
+            if isinstance(rhs, Const):
+                bld.restrict(bld.expr(lhs), -np.inf, float(rhs.value.hi))
+            elif isinstance(lhs, Const):
+                bld.restrict(bld.expr(rhs), float(lhs.value.lo), np.inf)
+            else:
+                bld.restrict(bld.expr(lhs - rhs), -np.inf, 0.0)
+    return _close(bld, merges)
+
+
+def _close(bld: _Builder, merges: list[tuple[int, int]]) -> Tape:
+    """Apply the equalities (union-find) and merge nodes that became identical."""
+    n = len(bld.lo)
+    parent = list(range(n))
+    # prefer variables, then lower slot numbers, as representatives
+    for s1, s2 in merges:
+        r1, r2 = _find(parent, s1), _find(parent, s2)
+        if r1 != r2:
+            parent[max(r1, r2)] = min(r1, r2)
+    nodes = bld.nodes
+    while True:
+        seen: dict[tuple, int] = {}
+        changed = False
+        for op, out, a, b, p in nodes:
+            key = (op, _find(parent, a), _find(parent, b) if b >= 0 else -1, p)
+            o = _find(parent, out)
+            prev = seen.setdefault(key, o)
+            if prev != o:
+                parent[max(prev, o)] = min(prev, o)
+                seen[key] = min(prev, o)
+                changed = True
+        if not changed:
+            break
+    roots = sorted({_find(parent, s) for s in range(n)})
+    new_id = {r: i for i, r in enumerate(roots)}
+    lo = np.full(len(roots), -np.inf)
+    hi = np.full(len(roots), np.inf)
+    for s in range(n):
+        r = new_id[_find(parent, s)]
+        lo[r] = max(lo[r], bld.lo[s])
+        hi[r] = min(hi[r], bld.hi[s])
+    empty = lo > hi
+    lo[empty] = hi[empty] = np.nan
+    uniq: dict[tuple, None] = {}
+    for op, out, a, b, p in nodes:
+        key = (op, new_id[_find(parent, out)], new_id[_find(parent, a)],
+               new_id[_find(parent, b)] if b >= 0 else -1, p)
+        uniq.setdefault(key, None)
+    arr = np.array(list(uniq), dtype=np.float64).reshape(-1, 5)
+    slot_of = {name: new_id[_find(parent, s)] for name, s in bld.slot_of.items()}
+    return Tape(lo=lo, hi=hi, slot_of=slot_of, op=arr[:, 0].astype(np.int32),
+                out=arr[:, 1].astype(np.int32), a=arr[:, 2].astype(np.int32),
+                b=arr[:, 3].astype(np.int32), param=arr[:, 4].copy())

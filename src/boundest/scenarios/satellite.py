@@ -1,0 +1,271 @@
+"""The satellite of seed 000 (equations 14-16, Remarks 2-3): state estimation as a CSP.
+
+State ``x = (x1, x2, x3, x4)`` (position and velocity), Euler step ``delta = 0.5``::
+
+    x1(k+1) = x1(k) + 0.5 x3(k) + w1(k)
+    x2(k+1) = x2(k) + 0.5 x4(k) + w2(k)
+    x3(k+1) = x3(k) - 0.5 x1(k) / sqrt(x1(k)^2 + x2(k)^2)^3 + w3(k)
+    x4(k+1) = x4(k) - 0.5 x2(k) / sqrt(x1(k)^2 + x2(k)^2)^3 + w4(k)
+    y1(k) = x2(k) / x1(k),  y2(k) = x1(k) x3(k) + x2(k) x4(k),  y3(k) = x1(k)^2 + x2(k)^2
+
+with ``w(k) in [-0.01, 0.01]^4``, ``y(k)`` measured to +-0.1, and (Remark 2, identifiability)
+``x1(0), x2(0), x4(0) >= 0``, ``x3(0) <= 0``. For ``k_max = 200``: 2215 variables, 1407
+constraints. The CSP is decomposed into primitive constraints with shared sub-expressions
+(``x1^2 + x2^2`` is computed once per step and shared by ``y3`` and the dynamics) and propagated
+to a fixed point by the compiled queue (``boundest.csp.propagate``).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..csp import propagate
+from ..csp.beta import BetaResult, beta_tuning
+from ..expr import Model, VarFamily
+from ..expr.nodes import Op
+from ..expr.tape import Tape, compile_model
+from ..interval import Interval
+from ._data import DataError, embedded, read_csv
+
+__all__ = [
+    "DELTA",
+    "W_BOUND",
+    "X0_TRUE",
+    "Measurements",
+    "SatelliteResult",
+    "build_model",
+    "load",
+    "model_text",
+    "simulate",
+    "solve",
+    "tune",
+]
+
+DELTA = 0.5
+W_BOUND = 0.01
+NOISE = 0.1
+#: Initial state used by the seed to generate its data (Remark 2).
+X0_TRUE = (4.0, 0.5, -0.2, 0.5)
+#: Sign restrictions of Remark 2 on x(0).
+X0_DOMAINS = ((0.0, np.inf), (0.0, np.inf), (-np.inf, 0.0), (0.0, np.inf))
+_COLUMNS = ["k", "y1_lo", "y1_hi", "y2_lo", "y2_hi", "y3_lo", "y3_hi"]
+
+
+@dataclass
+class Measurements:
+    """Output intervals ``y_lo[k, i] <= y_i(k) <= y_hi[k, i]`` for ``k = 0..k_max``."""
+
+    y_lo: np.ndarray
+    y_hi: np.ndarray
+    source: str = "<memory>"
+
+    @property
+    def k_max(self) -> int:
+        return len(self.y_lo) - 1
+
+
+def load(path: str | Path | None = None, k_max: int | None = None) -> Measurements:
+    """Read measurements (default: the embedded ``satellite_k200.csv`` or ``_k800`` file).
+
+    ``k`` must run 0, 1, ..., without gaps; ``k_max`` (if given) truncates the data and must not
+    exceed what the file holds.
+    """
+    if path is None:
+        path = embedded("satellite_k800.csv" if (k_max or 200) > 200 else "satellite_k200.csv")
+    cols = read_csv(path, _COLUMNS)
+    k = cols["k"]
+    expected = np.arange(len(k), dtype=float)
+    if not np.array_equal(k, expected):
+        j = int(np.nonzero(k != expected)[0][0])
+        raise DataError(f"{path}:{j + 2}: k = {float(k[j])!r}, expected {j} (k must run 0, 1, "
+                        "2, ...)")
+    y_lo = np.stack([cols[f"y{i}_lo"] for i in (1, 2, 3)], axis=1)
+    y_hi = np.stack([cols[f"y{i}_hi"] for i in (1, 2, 3)], axis=1)
+    if k_max is not None:
+        if not 1 <= k_max <= len(k) - 1:
+            raise DataError(f"{path}: k_max = {k_max} but the file holds k = 0..{len(k) - 1}")
+        y_lo, y_hi = y_lo[: k_max + 1], y_hi[: k_max + 1]
+    return Measurements(y_lo, y_hi, str(path))
+
+
+def step(x: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """One step of equation 14 on float arrays ``x[..., 4]``, ``w[..., 4]``."""
+    x1, x2, x3, x4 = np.moveaxis(x, -1, 0)
+    r3 = np.sqrt(x1**2 + x2**2) ** 3
+    return np.stack([x1 + DELTA * x3, x2 + DELTA * x4, x3 - DELTA * x1 / r3,
+                     x4 - DELTA * x2 / r3], axis=-1) + w
+
+
+def outputs(x: np.ndarray) -> np.ndarray:
+    """The outputs ``(y1, y2, y3)`` of equation 14."""
+    x1, x2, x3, x4 = np.moveaxis(x, -1, 0)
+    return np.stack([x2 / x1, x1 * x3 + x2 * x4, x1**2 + x2**2], axis=-1)
+
+
+def simulate(k_max: int, x0: tuple[float, ...] = X0_TRUE, seed: int | None = 0,
+             w_bound: float = W_BOUND, noise: float = NOISE
+             ) -> tuple[np.ndarray, Measurements]:
+    """Simulate equation 14 with uniform perturbations and output noise.
+
+    Returns the true states ``x[k]`` for ``k = 0..k_max+1`` and measurement intervals of
+    half-width ``noise`` around the noisy outputs (each interval contains the true output).
+    The perturbations are drawn in ``[-0.99, 0.99] w_bound`` so that rounding in this float
+    simulation cannot push the truth out of the model's ``[-w_bound, w_bound]``.
+    """
+    rng = np.random.default_rng(seed)
+    x = np.empty((k_max + 2, 4))
+    x[0] = x0
+    w = rng.uniform(-0.99 * w_bound, 0.99 * w_bound, size=(k_max + 1, 4))
+    for k in range(k_max + 1):  # a simulator: sequential by nature, not a hot path
+        x[k + 1] = step(x[k], w[k])
+    y = outputs(x[: k_max + 1])
+    meas = y + rng.uniform(-0.99 * noise, 0.99 * noise, size=y.shape)
+    return x, Measurements(meas - noise, meas + noise, "<simulated>")
+
+
+def build_model(meas: Measurements, beta: float = 1.0, w_bound: float = W_BOUND) -> Model:
+    """The CSP of equations 14-16, with perturbation and output intervals scaled by ``beta``
+    (seed 000 section 5.2: ``[w] = beta [w]``, ``[y] = mid + beta ([y] - mid)``)."""
+    if beta <= 0:
+        raise ValueError(f"beta must be positive, got {beta}")
+    K = meas.k_max
+    x = [VarFamily(f"x{i}") for i in (1, 2, 3, 4)]
+    w = [VarFamily(f"w{i}") for i in (1, 2, 3, 4)]
+    y = [VarFamily(f"y{i}") for i in (1, 2, 3)]
+    mid = 0.5 * (meas.y_lo + meas.y_hi)
+    rad = 0.5 * (meas.y_hi - meas.y_lo)
+    # outward rounding of the scaled intervals, so that beta = 1 keeps the data exactly
+    ylo = np.minimum(meas.y_lo, np.nextafter(mid - beta * rad, -np.inf)) if beta >= 1 else (
+        np.nextafter(mid - beta * rad, -np.inf))
+    yhi = np.maximum(meas.y_hi, np.nextafter(mid + beta * rad, np.inf)) if beta >= 1 else (
+        np.nextafter(mid + beta * rad, np.inf))
+    m = Model()
+    for i in range(4):
+        m.declare(x[i][0], X0_DOMAINS[i])
+    wb = w_bound * beta
+    for k in range(K + 1):
+        for i in range(4):
+            m.declare(w[i][k], (-wb, wb))
+        for i in range(3):
+            m.declare(y[i][k], (float(ylo[k, i]), float(yhi[k, i])))
+    for k in range(K + 1):
+        x1, x2, x3, x4 = (xi[k] for xi in x)
+        r2 = x1**2 + x2**2
+        r3 = Op("sqrt", (r2,)) ** 3
+        m.add(x[0][k + 1] == x1 + DELTA * x3 + w[0][k],
+              x[1][k + 1] == x2 + DELTA * x4 + w[1][k],
+              x[2][k + 1] == x3 - DELTA * x1 / r3 + w[2][k],
+              x[3][k + 1] == x4 - DELTA * x2 / r3 + w[3][k],
+              y[0][k] == x2 / x1,
+              y[1][k] == x1 * x3 + x2 * x4,
+              y[2][k] == r2)
+    return m
+
+
+def model_text(meas: Measurements) -> str:
+    """The same CSP in the model text format (RealPaver-like, seed 000 section 4)."""
+    K = meas.k_max
+    lines = ["// Satellite of seed 000 (equations 14-16), written by boundest", "Variables"]
+    decl = []
+    names = ("x1_0", "x2_0", "x3_0", "x4_0")
+    doms = ("[0, +oo[", "[0, +oo[", "]-oo, 0]", "[0, +oo[")
+    decl += [f"  {n} in {d}" for n, d in zip(names, doms, strict=True)]
+    for k in range(K + 1):
+        decl += [f"  w{i}_{k} in [-{W_BOUND!r}, {W_BOUND!r}]" for i in (1, 2, 3, 4)]
+        for i in (1, 2, 3):
+            lo, hi = float(meas.y_lo[k, i - 1]), float(meas.y_hi[k, i - 1])
+            decl.append(f"  y{i}_{k} in [{lo!r}, {hi!r}]")
+        decl += [f"  x{i}_{k + 1} in ]-oo, +oo[" for i in (1, 2, 3, 4)]
+    lines.append(",\n".join(decl) + ";")
+    lines.append("Constraints")
+    cons = []
+    for k in range(K + 1):
+        n = k + 1
+        r3 = f"(sqrt(x1_{k}^2+x2_{k}^2))^3"
+        cons += [f"  x1_{n} = x1_{k} + 0.5*x3_{k} + w1_{k}",
+                 f"  x2_{n} = x2_{k} + 0.5*x4_{k} + w2_{k}",
+                 f"  x3_{n} = x3_{k} - 0.5*x1_{k}/{r3} + w3_{k}",
+                 f"  x4_{n} = x4_{k} - 0.5*x2_{k}/{r3} + w4_{k}",
+                 f"  y1_{k} = x2_{k}/x1_{k}",
+                 f"  y2_{k} = x1_{k}*x3_{k} + x2_{k}*x4_{k}",
+                 f"  y3_{k} = x1_{k}^2 + x2_{k}^2"]
+    lines.append(",\n".join(cons) + ";")
+    return "\n".join(lines) + "\n"
+
+
+@dataclass
+class SatelliteResult:
+    """Enclosures of the states, ``x_lo[k], x_hi[k]`` for ``k = 0..k_max+1``."""
+
+    k_max: int
+    consistent: bool
+    iterations: float
+    evaluations: int
+    time_s: float
+    x_lo: np.ndarray
+    x_hi: np.ndarray
+    beta: float = 1.0
+
+    def to_json(self) -> dict:
+        def rows(a: np.ndarray) -> list:
+            return [[None if np.isnan(v) else float(v) for v in r] for r in a]
+
+        return {"scenario": "satellite", "k_max": self.k_max, "consistent": self.consistent,
+                "iterations": self.iterations, "evaluations": self.evaluations,
+                "time_s": self.time_s, "beta": self.beta,
+                "k": list(range(self.k_max + 2)), "x_lo": rows(self.x_lo),
+                "x_hi": rows(self.x_hi)}
+
+    def box(self, k: int) -> Interval:
+        return Interval._new(self.x_lo[k], self.x_hi[k])
+
+
+def _state_names(K: int) -> list[list[str]]:
+    return [[f"x{i}_{k}" for i in (1, 2, 3, 4)] for k in range(K + 2)]
+
+
+def _result(tape: Tape, prop, K: int, beta: float) -> SatelliteResult:
+    slots = np.array(_state_names(K), dtype=object)
+    idx = np.vectorize(tape.slot_of.__getitem__)(slots).astype(np.intp)
+    return SatelliteResult(K, prop.consistent, prop.iterations, prop.evaluations, prop.time_s,
+                           prop.slots.lo[idx], prop.slots.hi[idx], beta)
+
+
+def solve(meas: Measurements, rel_eps: float = 1e-3, progress: bool | None = None
+          ) -> SatelliteResult:
+    """Propagate the satellite CSP to its fixed point (``time_s``: propagation only)."""
+    tape = compile_model(build_model(meas))
+    prop = propagate(tape, rel_eps=rel_eps, progress=progress)
+    return _result(tape, prop, meas.k_max, 1.0)
+
+
+def tune(meas: Measurements, beta_max: float = 16.0, tol: float = 1e-3, rel_eps: float = 1e-3
+         ) -> tuple[BetaResult, SatelliteResult]:
+    """Beta-tuning (seed 000 section 5.2): the smallest ``beta`` in ``]0, beta_max]`` for which
+    the contracted CSP is not empty, and the domains at that ``beta``."""
+    K = meas.k_max
+    tape = compile_model(build_model(meas, beta=beta_max))
+    names = [f"w{i}_{k}" for k in range(K + 1) for i in (1, 2, 3, 4)]
+    ynames = [f"y{i}_{k}" for k in range(K + 1) for i in (1, 2, 3)]
+    mid = 0.5 * (meas.y_lo + meas.y_hi)
+    rad = 0.5 * (meas.y_hi - meas.y_lo)
+
+    def domains(beta: float) -> dict[str, Interval]:
+        wb = W_BOUND * beta
+        lo = np.nextafter(mid - beta * rad, -np.inf).ravel()
+        hi = np.nextafter(mid + beta * rad, np.inf).ravel()
+        d = {n: Interval(-wb, wb) for n in names}
+        d.update({n: Interval(a, b) for n, a, b in zip(ynames, lo, hi, strict=True)})
+        return d
+
+    t0 = time.perf_counter()
+    res = beta_tuning(lambda b: propagate(tape, rel_eps=rel_eps, domains=domains(b)),
+                      beta_max=beta_max, tol=tol)
+    res.time_s = time.perf_counter() - t0
+    return res, _result(tape, res.propagation, K, res.beta)
+
+

@@ -1,0 +1,113 @@
+"""The satellite scenario (seed 000): soundness on simulated truths, data checks, beta-tuning,
+the model text format and the command line."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from boundest.cli import main
+from boundest.csp import propagate
+from boundest.expr import load_model
+from boundest.scenarios import satellite as sat
+from boundest.scenarios._data import DataError, embedded
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_simulated_truth_stays_inside_every_domain(seed):
+    rng = np.random.default_rng(seed)
+    x0 = (rng.uniform(3, 5), rng.uniform(0, 1), rng.uniform(-0.4, 0), rng.uniform(0.2, 0.7))
+    truth, meas = sat.simulate(60, x0=x0, seed=seed)
+    res = sat.solve(meas)
+    assert res.consistent
+    assert np.all(res.x_lo <= truth) and np.all(truth <= res.x_hi), seed
+    # the enclosures are informative, not the whole line
+    assert np.all(np.isfinite(res.x_hi - res.x_lo))
+
+
+def test_published_data_enclosures_are_comparable_to_the_seed():
+    res = sat.solve(sat.load())
+    assert res.consistent
+    width = res.x_hi - res.x_lo
+    # seed 000 section 4 (RealPaver, its own data): x1(0) width 0.13, x2(0) 0.54, x3(0) 0.26,
+    # x4(0) 0.73; x(200) widths 0.50, 0.23, 0.69, 0.33. Same order of magnitude here:
+    assert np.all(width[0] < 0.9) and np.all(width[200] < 0.9)
+    assert np.mean(width[:, 0]) < 0.77  # Codac 1.5.7 on this data: mean width of x1 0.77
+
+
+def test_inconsistent_data_is_proven_empty_and_beta_tuning_recovers():
+    meas = sat.load(k_max=40)
+    bad = sat.Measurements(meas.y_lo.copy(), meas.y_hi.copy())
+    bad.y_lo[20, 2] += 1.0  # y3(20) = x1^2 + x2^2 shifted by 1 (5 half-widths)
+    bad.y_hi[20, 2] += 1.0
+    assert not sat.solve(bad).consistent
+    bres, res = sat.tune(bad, beta_max=16.0, tol=1e-3)
+    assert bres.beta > 1.0 and res.consistent and res.beta == bres.beta
+    assert np.all(np.isfinite(res.x_lo[1:]))
+    # just below the returned beta the CSP is empty (beta is the threshold within tol)
+    below = [b for b, ok in bres.trials if not ok]
+    assert below and max(below) > 0.99 * bres.beta
+
+
+def test_beta_tuning_on_consistent_data_goes_below_one():
+    bres, res = sat.tune(sat.load(k_max=40), beta_max=4.0, tol=1e-2)
+    assert bres.beta < 1.0 and res.consistent
+
+
+def test_model_text_file_gives_the_python_model_result():
+    text_res = propagate(load_model(embedded("satellite_k200.txt")))
+    py = sat.solve(sat.load())
+    assert text_res.consistent
+    for k in (0, 100, 201):
+        for i in range(4):
+            d = text_res[f"x{i + 1}_{k}"]
+            # decimals in the file are enclosed outward: the same or very slightly wider
+            assert float(d.lo) <= py.x_lo[k, i] + 1e-9 and py.x_hi[k, i] - 1e-9 <= float(d.hi)
+            assert float(d.hi) - float(d.lo) < (py.x_hi[k, i] - py.x_lo[k, i]) + 1e-6
+
+
+def test_bad_data_files_are_rejected_with_file_and_line(tmp_path):
+    f = tmp_path / "m.csv"
+    f.write_text("k,y1_lo,y1_hi,y2_lo,y2_hi,y3_lo,y3_hi\n0,0,1,0,1,0,1\n1,0,1,0,1,2,1\n")
+    with pytest.raises(DataError, match=r"m.csv:3: y3_lo = 2.0 is above y3_hi = 1.0"):
+        sat.load(f)
+    f.write_text("k,y1_lo,y1_hi,y2_lo,y2_hi,y3_lo,y3_hi\n0,0,1,0,1,0,1\n2,0,1,0,1,0,1\n")
+    with pytest.raises(DataError, match=r"m.csv:3: k = 2.0, expected 1"):
+        sat.load(f)
+    f.write_text("k,y1_lo,y1_hi,y2_lo,y2_hi,y3_lo,y3_hi\n0,0,nan,0,1,0,1\n")
+    with pytest.raises(DataError, match=r"m.csv:2: column y1_hi: non-finite"):
+        sat.load(f)
+    f.write_text("k,y1_lo,y1_hi\n0,0,1\n")
+    with pytest.raises(DataError, match=r"m.csv:1: missing column"):
+        sat.load(f)
+    with pytest.raises(DataError, match="k_max = 500"):
+        sat.load(k_max=500, path=embedded("satellite_k200.csv"))
+
+
+def test_cli_run_satellite_writes_json_and_figure(tmp_path, capsys):
+    js = tmp_path / "s.json"
+    assert main(["run", "satellite", "--json", str(js), "--out", str(tmp_path)]) == 0
+    data = json.loads(js.read_text())
+    assert data["scenario"] == "satellite" and data["k_max"] == 200 and data["consistent"]
+    assert data["k"] == list(range(202)) and len(data["x_lo"]) == 202
+    assert all(len(r) == 4 for r in data["x_hi"]) and data["time_s"] > 0
+    lo, hi = np.array(data["x_lo"]), np.array(data["x_hi"])
+    assert np.all(lo <= hi)
+    assert (tmp_path / "satellite_k200.png").stat().st_size > 20_000
+    assert "fixed point reached" in capsys.readouterr().out
+
+
+def test_cli_solve_prints_domains_and_flags_errors(tmp_path, capsys):
+    m = tmp_path / "m.txt"
+    m.write_text("x in [0, 10], y in [0, 10];\nConstraints\nx + y = 3, x - y = 1, x >= 1.5;\n")
+    assert main(["solve", str(m)]) == 0
+    out = capsys.readouterr().out
+    assert "consistent" in out and "x in [1.5, 2.5]" in out and "y in [0.5, 1.5]" in out
+    m.write_text("x in [0, 1], y in [0, 1];\nConstraints\nx + y = 3;\n")
+    assert main(["solve", str(m)]) == 1
+    assert "INCONSISTENT" in capsys.readouterr().out
+    m.write_text("x in [0, 1];\nConstraints\nx + = 3;\n")
+    assert main(["solve", str(m)]) == 2
+    assert f"{m}:3:5" in capsys.readouterr().err
