@@ -26,7 +26,7 @@ import numpy as np
 from ..csp import propagate
 from ..csp.beta import BetaResult, beta_tuning
 from ..expr import Model, VarFamily
-from ..expr.nodes import Op
+from ..expr.functions import sqrt
 from ..expr.tape import Tape, compile_model
 from ..interval import Interval
 from ._data import DataError, embedded, read_csv
@@ -155,7 +155,7 @@ def build_model(meas: Measurements, beta: float = 1.0, w_bound: float = W_BOUND)
     for k in range(K + 1):
         x1, x2, x3, x4 = (xi[k] for xi in x)
         r2 = x1**2 + x2**2
-        r3 = Op("sqrt", (r2,)) ** 3
+        r3 = sqrt(r2) ** 3
         m.add(x[0][k + 1] == x1 + DELTA * x3 + w[0][k],
               x[1][k + 1] == x2 + DELTA * x4 + w[1][k],
               x[2][k + 1] == x3 - DELTA * x1 / r3 + w[2][k],
