@@ -165,11 +165,13 @@ def mul_up(a: float, b: float) -> float:
 @_jit
 def _div_err(a: float, b: float, q: float) -> float:
     """Sign of ``a/b - q`` for ``q = RN(a/b)``, ``b != 0``: the exact remainder ``a - q*b``
-    (FMA) times the sign of ``b``; NaN (unknown: step outward) in the underflow range and
-    with infinite operands, where ``_lower``/``_upper`` still give sound bounds."""
+    (FMA) times the sign of ``b``; exact for ``a = 0`` and ``a / inf``; NaN (unknown: step
+    outward) in the underflow range and for an infinite ``a``, where ``_lower``/``_upper``
+    still give sound bounds."""
     r = fma(-q, b, a)
     e = r if b > 0.0 else -r
     e = NAN if (abs(q) < TINY or abs(a) < TINY) else e
+    e = 0.0 if abs(b) == INF else e  # a / inf = 0 exactly (inf / inf is NaN anyway)
     return 0.0 if a == 0.0 else e
 
 
