@@ -60,7 +60,7 @@ class CtcFwdBwd(Contractor):
     >>> x, y = Var("x"), Var("y")
     >>> ctc = CtcFwdBwd([x + y == 3, x - y == 1], ["x", "y"])
     >>> ctc(Interval([0, 0], [10, 10]))
-    Interval([[0.0, 3.0], [0.0, 3.0]])
+    Interval([[1.0, 3.0], [0.0, 2.0]])
     """
 
     def __init__(self, constraints: Model | Seq[Constraint] | Tape,
