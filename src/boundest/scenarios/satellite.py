@@ -18,7 +18,7 @@ to a fixed point by the compiled queue (``boundest.csp.propagate``).
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -249,21 +249,22 @@ def tune(meas: Measurements, beta_max: float = 16.0, tol: float = 1e-3, rel_eps:
     the contracted CSP is not empty, and the domains at that ``beta``."""
     K = meas.k_max
     tape = compile_model(build_model(meas, beta=beta_max))
-    names = [f"w{i}_{k}" for k in range(K + 1) for i in (1, 2, 3, 4)]
-    ynames = [f"y{i}_{k}" for k in range(K + 1) for i in (1, 2, 3)]
-    mid = 0.5 * (meas.y_lo + meas.y_hi)
-    rad = 0.5 * (meas.y_hi - meas.y_lo)
+    w_slots = np.array([tape.slot_of[f"w{i}_{k}"] for k in range(K + 1) for i in (1, 2, 3, 4)])
+    y_slots = np.array([tape.slot_of[f"y{i}_{k}"] for k in range(K + 1) for i in (1, 2, 3)])
+    mid = (0.5 * (meas.y_lo + meas.y_hi)).ravel()
+    rad = (0.5 * (meas.y_hi - meas.y_lo)).ravel()
 
-    def domains(beta: float) -> dict[str, Interval]:
-        wb = W_BOUND * beta
-        lo = np.nextafter(mid - beta * rad, -np.inf).ravel()
-        hi = np.nextafter(mid + beta * rad, np.inf).ravel()
-        d = {n: Interval(-wb, wb) for n in names}
-        d.update({n: Interval(a, b) for n, a, b in zip(ynames, lo, hi, strict=True)})
-        return d
+    def at(beta: float) -> Tape:
+        """The tape with the perturbation and output domains scaled by ``beta``."""
+        lo, hi = tape.lo.copy(), tape.hi.copy()
+        lo[w_slots] = np.maximum(lo[w_slots], -W_BOUND * beta)
+        hi[w_slots] = np.minimum(hi[w_slots], W_BOUND * beta)
+        lo[y_slots] = np.maximum(lo[y_slots], np.nextafter(mid - beta * rad, -np.inf))
+        hi[y_slots] = np.minimum(hi[y_slots], np.nextafter(mid + beta * rad, np.inf))
+        return replace(tape, lo=lo, hi=hi)
 
     t0 = time.perf_counter()
-    res = beta_tuning(lambda b: propagate(tape, rel_eps=rel_eps, domains=domains(b)),
+    res = beta_tuning(lambda b: propagate(at(b), rel_eps=rel_eps),
                       beta_max=beta_max, tol=tol)
     res.time_s = time.perf_counter() - t0
     return res, _result(tape, res.propagation, K, res.beta)
