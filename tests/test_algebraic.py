@@ -694,6 +694,31 @@ def test_rev_empty_and_broadcast_and_out():
     assert np.array_equal(o.lo, [2.0, np.nan, 3.0], equal_nan=True)
 
 
+def test_in_place_contraction():
+    """``out`` may be the contracted argument itself (the usual contractor pattern)."""
+    rng = np.random.default_rng(1)
+    lo = rng.uniform(-3, 3, 500)
+    x0 = Interval(lo, lo + rng.uniform(0, 3, 500))
+    y0 = Interval(lo[::-1], lo[::-1] + 1.0)
+    z = Interval(np.full(500, 1.0), np.full(500, 4.0))
+    want = alg.sqr_rev(z, x0)
+    x = x0.copy()
+    assert alg.sqr_rev(z, x, out=x) is x
+    assert np.array_equal(x.lo, want.lo, equal_nan=True)
+    assert np.array_equal(x.hi, want.hi, equal_nan=True)
+    wx, wy = alg.mul_rev(z, x0, y0)
+    x, y = x0.copy(), y0.copy()
+    alg.mul_rev(z, x, y, out=(x, y))
+    assert np.array_equal(x.lo, wx.lo, equal_nan=True) and np.array_equal(x.hi, wx.hi,
+                                                                          equal_nan=True)
+    assert np.array_equal(y.lo, wy.lo, equal_nan=True) and np.array_equal(y.hi, wy.hi,
+                                                                          equal_nan=True)
+    w = alg.abs(x0)
+    x = x0.copy()
+    alg.abs(x, out=x)
+    assert np.array_equal(x.lo, w.lo) and np.array_equal(x.hi, w.hi)
+
+
 # -------------------------------------------------------------------------------------------
 # ITF1788 vectors of these functions (a check of this module only; the full harness is
 # tests/test_itf1788.py)

@@ -137,6 +137,7 @@ def test_signed_zero_and_tiny_products():
     t = bd.mul(Interval(2.0**-600), Interval(2.0**-600))  # underflows to 0
     # sound, and at most one subnormal step on each side (the kernels stay branch-free)
     assert t.lo == -(2.0**-1074) and t.hi == 2.0**-1074
+    assert bd.sqr(Interval(1e-200)) == Interval(0, 2.0**-1074)  # a square stays >= 0
 
 
 def test_broadcasting_and_out_buffers():

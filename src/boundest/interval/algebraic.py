@@ -8,12 +8,14 @@ semantics). Backward operators contract their arguments: the unary ``f_rev(z, x)
 of the corresponding input and contains every point of the exact set; the empty set is
 ``[nan, nan]`` and any empty argument makes every result empty.
 
-``pown`` evaluates integer powers in double-word arithmetic (a product of two double-words has
-a relative error below ``7 u^2``, Joldes, Muller and Popescu, ACM TOMS 2017) with a running
-rigorous error bound, and exact results are detected, so its bounds are the tightest float64
-ones except in rare hard-to-round cases, where they are one ulp wider. Roots (``pown_rev``) are
-found by a floating-point guess that is then verified (and tightened) with those rigorous
-power bounds.
+Kernels are written with selects rather than branches (rounding directions and signs are random
+on real data): forward functions and unary backward operators are one Numba ufunc per bound
+(vectorised loops), binary backward operators one gufunc per element. ``pown`` evaluates integer
+powers in double-word arithmetic (a product of two double-words has a relative error below
+``7 u^2``, Joldes, Muller and Popescu, ACM TOMS 2017) with a running rigorous error bound, and
+exact results are detected, so its bounds are the tightest float64 ones except in rare
+hard-to-round cases, where they are one ulp wider. Roots (``pown_rev``) are found by a
+floating-point guess that is then verified (and tightened) with those rigorous power bounds.
 """
 
 from __future__ import annotations
@@ -43,6 +45,7 @@ from .rounding import (
     sqrt_up,
     sub_dn,
     sub_up,
+    ufunc,
 )
 
 __all__ = [
@@ -74,6 +77,7 @@ IntervalLike = ArrayLike | Interval
 _babs = abs
 _bmin = min
 _bmax = max
+_bany = any
 
 _jit = nb.njit(inline="always", cache=True)
 #: Larger helpers (loops) are compiled once and called, not inlined everywhere.
@@ -113,49 +117,39 @@ def _int_gufunc(nin_float: int, nout: int = 2) -> Callable[[Callable], _LazyIntG
 # ----------------------------------------------------------------------------------------
 # scalar helpers
 # ----------------------------------------------------------------------------------------
+# The helpers and kernels below are written with selects (``a if c else b``), not branches or
+# and/or chains: the ufunc loops then run them with SIMD, and no misprediction is paid on the
+# random outcomes (rounding directions, signs). Numba's min()/max() check for NaN and block
+# vectorisation; _smin/_smax are plain selects (a NaN argument is handled by the callers).
 @_jit
-def _meet(xl, xh, l, h):
-    """``[xl, xh] ∩ [l, h]``; empty when the returned lo > hi (no NaN inputs)."""
-    lo = xl if xl > l else l
-    hi = xh if xh < h else h
+def _smin(a, b):
+    return a if a < b else b
+
+
+@_jit
+def _smax(a, b):
+    return a if a > b else b
+
+
+@_jit
+def _hull2(xl, xh, l1, h1, l2, h2):
+    """``hull(X ∩ P1, X ∩ P2)`` as ``(lo, hi)``, ``(nan, nan)`` when empty; a piece with
+    ``l > h`` is empty. X must be non-empty (checked by the callers)."""
+    a = _smax(xl, l1)
+    b = _smin(xh, h1)
+    c = _smax(xl, l2)
+    d = _smin(xh, h2)
+    ok1 = a <= b
+    ok2 = c <= d
+    lo = (_smin(a, c) if ok2 else a) if ok1 else (c if ok2 else NAN)
+    hi = (_smax(b, d) if ok2 else b) if ok1 else (d if ok2 else NAN)
     return lo, hi
 
 
 @_jit
-def _hull_meet2(xl, xh, l1, h1, l2, h2):
-    """``hull(X ∩ P1, X ∩ P2)``; pieces with ``l > h`` are empty; empty result has lo > hi."""
-    a, b = _meet(xl, xh, l1, h1)
-    c, d = _meet(xl, xh, l2, h2)
-    if a > b:
-        return c, d
-    if c > d:
-        return a, b
-    return (a if a < c else c), (b if b > d else d)
-
-
-@_jit
-def _div_nz_operands(cl, ch, bl, bh):
-    """Corners ``(n1, d1, n2, d2)`` with ``C / B = [n1 / d1, n2 / d2]`` for ``0 not in B``.
-
-    Sign case analysis; no inf/inf corner is ever selected (``C``, ``B`` non-empty).
-    """
-    if bl > 0.0:
-        if cl >= 0.0:
-            return cl, bh, ch, bl
-        if ch <= 0.0:
-            return cl, bl, ch, bh
-        return cl, bl, ch, bl
-    if cl >= 0.0:
-        return ch, bh, cl, bl
-    if ch <= 0.0:
-        return ch, bl, cl, bh
-    return ch, bh, cl, bh
-
-
-@_jit
 def _q_dn(n, d):
-    """Lower bound of ``n / d`` for finite ``n`` or finite ``d`` (``d != 0``); ``n / ±inf``
-    is the limit 0 exactly (``div_dn`` alone would step out to ``-ETA``)."""
+    """Lower bound of ``n / d`` (``d != 0``, not both infinite); ``n / ±inf`` is the limit 0
+    exactly (``div_dn`` alone steps out to ``-ETA`` there)."""
     r = div_dn(n, d)
     return 0.0 if _babs(d) == INF else r
 
@@ -171,65 +165,59 @@ def _div_pair(cl, ch, bl, bh):
     """``{x : exists b in B, c in C, x*b = c}`` as two pieces ``(l1, h1, l2, h2)``.
 
     The first piece is the lower one; an absent piece is ``(INF, -INF)`` and the second is
-    absent whenever the set is one interval (IEEE 1788 mulRevToPair, C and B non-empty).
-    Every case needs at most one downward and one upward division.
+    absent whenever the set is one interval (IEEE 1788 mulRevToPair; C and B non-empty).
+    Every case needs one downward and one upward division, whose operands are selected first.
     """
-    if bl > 0.0 or bh < 0.0:
-        n1, d1, n2, d2 = _div_nz_operands(cl, ch, bl, bh)
-        return _q_dn(n1, d1), _q_up(n2, d2), INF, -INF
-    if cl <= 0.0 <= ch:  # 0 in B and 0 in C: x * 0 = 0 for every x
-        return -INF, INF, INF, -INF
-    # 0 in B, 0 not in C. With c > 0: b < 0 gives x <= cl/bl, b > 0 gives x >= cl/bh.
-    # With c < 0: b > 0 gives x <= ch/bh, b < 0 gives x >= ch/bl.
-    if cl > 0.0:
-        c = cl
-        has1 = bl < 0.0
-        has2 = bh > 0.0
-        d1 = bl
-        d2 = bh
-    else:
-        c = ch
-        has1 = bh > 0.0
-        has2 = bl < 0.0
-        d1 = bh
-        d2 = bl
-    if has1 and has2:
-        return -INF, _q_up(c, d1), _q_dn(c, d2), INF
-    if has1:
-        return -INF, _q_up(c, d1), INF, -INF
-    if has2:
-        return _q_dn(c, d2), INF, INF, -INF
-    return INF, -INF, INF, -INF  # B = [0, 0]
-
-
-@_jit
-def _mul_operands(al, ah, bl, bh):
-    """Corners for ``A * B`` (sign case analysis): lo = min of the first two products,
-    hi = max of the last two."""
-    if al >= 0.0:
-        if bl >= 0.0:
-            return al, bl, al, bl, ah, bh, ah, bh
-        if bh <= 0.0:
-            return ah, bl, ah, bl, al, bh, al, bh
-        return ah, bl, ah, bl, ah, bh, ah, bh
-    if ah <= 0.0:
-        if bl >= 0.0:
-            return al, bh, al, bh, ah, bl, ah, bl
-        if bh <= 0.0:
-            return ah, bh, ah, bh, al, bl, al, bl
-        return al, bh, al, bh, al, bl, al, bl
-    if bl >= 0.0:
-        return al, bh, al, bh, ah, bh, ah, bh
-    if bh <= 0.0:
-        return ah, bl, ah, bl, al, bl, al, bl
-    return al, bh, ah, bl, al, bl, ah, bh
+    pos = bl > 0.0
+    nz = pos | (bh < 0.0)  # 0 not in B: C / B = [n1 / d1, n2 / d2], sign case analysis
+    cpos = cl >= 0.0
+    cneg = ch <= 0.0
+    n1 = cl if pos else ch
+    n2 = ch if pos else cl
+    d1 = (bh if cpos else bl) if pos else (bh if cpos else (bl if cneg else bh))
+    d2 = (bl if cpos else (bh if cneg else bl)) if pos else (bl if cpos else bh)
+    # 0 in B, 0 not in C. For C > 0: b < 0 gives x <= cl/bl, b > 0 gives x >= cl/bh;
+    # for C < 0: b > 0 gives x <= ch/bh, b < 0 gives x >= ch/bl.
+    cp = cl > 0.0
+    c = cl if cp else ch
+    e1 = bl if cp else bh
+    e2 = bh if cp else bl
+    has1 = (bl < 0.0) if cp else (bh > 0.0)
+    has2 = (bh > 0.0) if cp else (bl < 0.0)
+    qd = _q_dn(n1 if nz else c, d1 if nz else e2)
+    qu = _q_up(n2 if nz else c, d2 if nz else e1)
+    zc = (cl <= 0.0) & (ch >= 0.0)  # 0 in B and 0 in C: x * 0 = 0 for every x
+    both = has1 & has2
+    l1 = qd if nz else (-INF if zc else (-INF if has1 else (qd if has2 else INF)))
+    h1 = qu if nz else (INF if zc else (qu if has1 else (INF if has2 else -INF)))
+    l2 = INF if nz else (INF if zc else (qd if both else INF))
+    h2 = -INF if nz else (-INF if zc else (INF if both else -INF))
+    return l1, h1, l2, h2
 
 
 @_jit
 def _mul_lohi(al, ah, bl, bh):
-    """Tightest enclosure of ``A * B`` (non-empty), with ``0 * inf = 0``."""
-    p1, q1, p2, q2, p3, q3, p4, q4 = _mul_operands(al, ah, bl, bh)
-    return _bmin(mul_dn(p1, q1), mul_dn(p2, q2)), _bmax(mul_up(p3, q3), mul_up(p4, q4))
+    """Tightest enclosure of ``A * B`` (non-empty), with ``0 * inf = 0``.
+
+    Sign case analysis (selects): only the corners that can be extreme are multiplied, so a
+    zero bound is never paired with a tiny one whose product would underflow and step out.
+    """
+    apos = al >= 0.0
+    aneg = ah <= 0.0
+    bpos = bl >= 0.0
+    bneg = bh <= 0.0
+    mixed = (not apos) & (not aneg) & (not bpos) & (not bneg)  # 0 inside both
+    p1 = (al if bpos else ah) if apos else (al if bpos else (ah if bneg else al))
+    q1 = bl if apos else (bh if aneg else (bh if bpos else (bl if bneg else bh)))
+    p3 = (ah if bpos else (al if bneg else ah)) if apos else (ah if bpos else al)
+    q3 = bh if apos else (bl if aneg else (bh if bpos else bl))
+    lo = mul_dn(p1, q1)
+    hi = mul_up(p3, q3)
+    lo2 = mul_dn(ah, bl)  # the other candidates when 0 is inside both factors
+    hi2 = mul_up(ah, bh)
+    lo = _smin(lo, lo2) if mixed else lo
+    hi = _smax(hi, hi2) if mixed else hi
+    return lo, hi
 
 
 #: 2**k for -1022 <= k <= 1023, index k + 1022 (a table: cheaper than ldexp in kernels)
@@ -537,22 +525,154 @@ def _root_up(c, n):
 
 
 # ----------------------------------------------------------------------------------------
-# forward kernels
+# forward kernels: one branch-free ufunc per bound (pown: a gufunc with an integer exponent)
 # ----------------------------------------------------------------------------------------
+@_jit
+def _abs_all(xl, xh):
+    lo = (xl + 0.0) if xl >= 0.0 else ((0.0 - xh) if xh <= 0.0 else 0.0)  # + 0.0: no -0.0
+    return (lo if xl == xl else NAN), _smax(-xl, xh)  # NaN stays NaN in the upper bound
+
+
+@_jit
+def _min_all(al, ah, bl, bh):
+    ok = (al == al) & (bl == bl)
+    return (_smin(al, bl) if ok else NAN), (_smin(ah, bh) if ok else NAN)
+
+
+@_jit
+def _max_all(al, ah, bl, bh):
+    ok = (al == al) & (bl == bl)
+    return (_smax(al, bl) if ok else NAN), (_smax(ah, bh) if ok else NAN)
+
+
+@_jit
+def _sign_all(xl, xh):
+    lo = -1.0 if xl < 0.0 else (1.0 if xl > 0.0 else 0.0)
+    hi = 1.0 if xh > 0.0 else (-1.0 if xh < 0.0 else 0.0)
+    return (lo if xl == xl else NAN), (hi if xl == xl else NAN)
+
+
+@_jit
+def _floor_all(xl, xh):  # floor, ceil and trunc are exact; NaN stays NaN
+    return np.floor(xl), np.floor(xh)
+
+
+@_jit
+def _ceil_all(xl, xh):
+    return np.ceil(xl), np.ceil(xh)
+
+
+@_jit
+def _trunc_all(xl, xh):
+    return np.trunc(xl), np.trunc(xh)
+
+
+@ufunc(2)
+def _abs_lo(xl, xh):
+    return _abs_all(xl, xh)[0]
+
+
+@ufunc(2)
+def _abs_hi(xl, xh):
+    return _abs_all(xl, xh)[1]
+
+
+@ufunc(2)
+def _sign_lo(xl, xh):
+    return _sign_all(xl, xh)[0]
+
+
+@ufunc(2)
+def _sign_hi(xl, xh):
+    return _sign_all(xl, xh)[1]
+
+
+@ufunc(2)
+def _floor_lo(xl, xh):
+    return _floor_all(xl, xh)[0]
+
+
+@ufunc(2)
+def _floor_hi(xl, xh):
+    return _floor_all(xl, xh)[1]
+
+
+@ufunc(2)
+def _ceil_lo(xl, xh):
+    return _ceil_all(xl, xh)[0]
+
+
+@ufunc(2)
+def _ceil_hi(xl, xh):
+    return _ceil_all(xl, xh)[1]
+
+
+@ufunc(2)
+def _trunc_lo(xl, xh):
+    return _trunc_all(xl, xh)[0]
+
+
+@ufunc(2)
+def _trunc_hi(xl, xh):
+    return _trunc_all(xl, xh)[1]
+
+
+@ufunc(4)
+def _min_lo(al, ah, bl, bh):
+    return _min_all(al, ah, bl, bh)[0]
+
+
+@ufunc(4)
+def _min_hi(al, ah, bl, bh):
+    return _min_all(al, ah, bl, bh)[1]
+
+
+@ufunc(4)
+def _max_lo(al, ah, bl, bh):
+    return _max_all(al, ah, bl, bh)[0]
+
+
+@ufunc(4)
+def _max_hi(al, ah, bl, bh):
+    return _max_all(al, ah, bl, bh)[1]
+
+
+# Element kernels with the gufunc calling convention (outputs are 1-element arrays), whose
+# ``.scalar`` compiled callers (the propagation engine) use; the public functions run the
+# ufuncs above.
 @gufunc(2)
 def _abs(xl, xh, lo, hi):
-    if xl >= 0.0:
-        lo[0] = _babs(xl)
-        hi[0] = xh
-    elif xh <= 0.0:
-        lo[0] = _babs(xh)
-        hi[0] = -xl
-    elif xl == xl:
-        lo[0] = 0.0
-        hi[0] = _bmax(-xl, xh)
-    else:
-        lo[0] = NAN
-        hi[0] = NAN
+    lo[0], hi[0] = _abs_all(xl, xh)
+
+
+@gufunc(2)
+def _sign(xl, xh, lo, hi):
+    lo[0], hi[0] = _sign_all(xl, xh)
+
+
+@gufunc(2)
+def _floor(xl, xh, lo, hi):
+    lo[0], hi[0] = _floor_all(xl, xh)
+
+
+@gufunc(2)
+def _ceil(xl, xh, lo, hi):
+    lo[0], hi[0] = _ceil_all(xl, xh)
+
+
+@gufunc(2)
+def _trunc(xl, xh, lo, hi):
+    lo[0], hi[0] = _trunc_all(xl, xh)
+
+
+@gufunc(4)
+def _min(al, ah, bl, bh, lo, hi):
+    lo[0], hi[0] = _min_all(al, ah, bl, bh)
+
+
+@gufunc(4)
+def _max(al, ah, bl, bh, lo, hi):
+    lo[0], hi[0] = _max_all(al, ah, bl, bh)
 
 
 @_int_gufunc(2)
@@ -597,196 +717,308 @@ def _pown(xl, xh, n, lo, hi):
         hi[0] = _pow_hi(ml, n)
 
 
-@gufunc(4)
-def _min(al, ah, bl, bh, lo, hi):
-    if al != al or bl != bl:
-        lo[0] = NAN
-        hi[0] = NAN
-        return
-    lo[0] = _bmin(al, bl)
-    hi[0] = _bmin(ah, bh)
-
-
-@gufunc(4)
-def _max(al, ah, bl, bh, lo, hi):
-    if al != al or bl != bl:
-        lo[0] = NAN
-        hi[0] = NAN
-        return
-    lo[0] = _bmax(al, bl)
-    hi[0] = _bmax(ah, bh)
-
-
-@gufunc(2)
-def _sign(xl, xh, lo, hi):
-    if xl != xl:
-        lo[0] = NAN
-        hi[0] = NAN
-        return
-    lo[0] = -1.0 if xl < 0.0 else (1.0 if xl > 0.0 else 0.0)
-    hi[0] = 1.0 if xh > 0.0 else (-1.0 if xh < 0.0 else 0.0)
-
-
-@gufunc(2)
-def _floor(xl, xh, lo, hi):
-    lo[0] = np.floor(xl)  # exact; NaN stays NaN, infinities stay
-    hi[0] = np.floor(xh)
-
-
-@gufunc(2)
-def _ceil(xl, xh, lo, hi):
-    lo[0] = np.ceil(xl)
-    hi[0] = np.ceil(xh)
-
-
-@gufunc(2)
-def _trunc(xl, xh, lo, hi):
-    lo[0] = np.trunc(xl)
-    hi[0] = np.trunc(xh)
-
-
 # ----------------------------------------------------------------------------------------
-# backward kernels
+# backward kernels: a select-based scalar function computes every result (NaN when empty).
+# Unary operators run one ufunc per bound (SIMD); binary ones run one gufunc per element,
+# since four ufuncs would each redo the whole work. x' and y' are empty together.
 # ----------------------------------------------------------------------------------------
+@_jit
+def _nonempty3(zl, xl, yl):
+    return (zl == zl) & (xl == xl) & (yl == yl)
+
+
+@_jit
+def _finish2(a, b, c, d, ok):
+    """``(x', y')`` bounds, all NaN unless ``ok`` and both are non-empty."""
+    ok = ok & (a <= b) & (c <= d)
+    return (a if ok else NAN), (b if ok else NAN), (c if ok else NAN), (d if ok else NAN)
+
+
+@_jit
+def _add_rev_all(zl, zh, xl, xh, yl, yh):
+    # x in Z - Y, then y in Z - X'
+    a = _smax(xl, sub_dn(zl, yh))
+    b = _smin(xh, sub_up(zh, yl))
+    c = _smax(yl, sub_dn(zl, b))
+    d = _smin(yh, sub_up(zh, a))
+    return _finish2(a, b, c, d, _nonempty3(zl, xl, yl))
+
+
+@_jit
+def _sub_rev_all(zl, zh, xl, xh, yl, yh):
+    # z = x - y: x in Z + Y, then y in X' - Z
+    a = _smax(xl, add_dn(zl, yl))
+    b = _smin(xh, add_up(zh, yh))
+    c = _smax(yl, sub_dn(a, zh))
+    d = _smin(yh, sub_up(b, zl))
+    return _finish2(a, b, c, d, _nonempty3(zl, xl, yl))
+
+
+@_jit
+def _mul_rev_all(zl, zh, xl, xh, yl, yh):
+    # z = x*y: x in X ∩ mulRevToPair(Y, Z) (two pieces), then y in Y ∩ mulRevToPair(X', Z)
+    l1, h1, l2, h2 = _div_pair(zl, zh, yl, yh)
+    a, b = _hull2(xl, xh, l1, h1, l2, h2)
+    l1, h1, l2, h2 = _div_pair(zl, zh, a, b)
+    c, d = _hull2(yl, yh, l1, h1, l2, h2)
+    return _finish2(a, b, c, d, _nonempty3(zl, xl, yl))
+
+
+@_jit
+def _div_rev_all(zl, zh, xl, xh, yl, yh):
+    # z = x/y (y != 0): x in X ∩ Z*Y, then y in Y ∩ {y : exists z in Z, y*z in X'}, y != 0
+    pl, ph = _mul_lohi(zl, zh, yl, yh)
+    a = _smax(xl, pl)
+    b = _smin(xh, ph)
+    l1, h1, l2, h2 = _div_pair(a, b, zl, zh)
+    c, d = _hull2(yl, yh, l1, h1, l2, h2)
+    ok = _nonempty3(zl, xl, yl) & ((c != 0.0) | (d != 0.0))  # y = 0 is no divisor
+    return _finish2(a, b, c, d, ok)
+
+
+@_jit
+def _min_rev_all(zl, zh, xl, xh, yl, yh):
+    # min(x, y) in Z: (x in Z and some y >= x) or (some y in Y ∩ Z with y <= x)
+    yz = _smax(yl, zl) <= _smin(yh, zh)
+    a, b = _hull2(xl, xh, zl, _smin(zh, yh), _smax(yl, zl) if yz else INF, INF if yz else -INF)
+    xz = _smax(a, zl) <= _smin(b, zh)
+    c, d = _hull2(yl, yh, zl, _smin(zh, b), _smax(a, zl) if xz else INF, INF if xz else -INF)
+    return _finish2(a, b, c, d, _nonempty3(zl, xl, yl))
+
+
+@_jit
+def _max_rev_all(zl, zh, xl, xh, yl, yh):
+    # max(x, y) in Z: (x in Z and some y <= x) or (some y in Y ∩ Z with y >= x)
+    yz = _smax(yl, zl) <= _smin(yh, zh)
+    a, b = _hull2(xl, xh, _smax(zl, yl), zh, -INF if yz else INF, _smin(yh, zh) if yz else -INF)
+    xz = _smax(a, zl) <= _smin(b, zh)
+    c, d = _hull2(yl, yh, _smax(zl, a), zh, -INF if xz else INF, _smin(b, zh) if xz else -INF)
+    return _finish2(a, b, c, d, _nonempty3(zl, xl, yl))
+
+
+@_jit
+def _finish1(a, b, ok):
+    ok = ok & (a <= b)
+    return (a if ok else NAN), (b if ok else NAN)
+
+
+@_jit
+def _neg_rev_all(zl, zh, xl, xh):
+    return _finish1(_smax(xl, -zh), _smin(xh, -zl), (zl == zl) & (xl == xl))
+
+
+@_jit
+def _sqr_rev_all(zl, zh, xl, xh):
+    # x in [-sqrt(zh), -sqrt(zl)] u [sqrt(zl), sqrt(zh)] (Z ∩ [0, inf])
+    sl = sqrt_dn(_smax(zl, 0.0))
+    sh = sqrt_up(zh)
+    a, b = _hull2(xl, xh, -sh, -sl, sl, sh)
+    return _finish1(a, b, (zh >= 0.0) & (xl == xl))
+
+
+@_jit
+def _sqrt_rev_all(zl, zh, xl, xh):
+    zl0 = _smax(zl, 0.0)
+    a = _smax(xl, _smax(mul_dn(zl0, zl0), 0.0))
+    b = _smin(xh, mul_up(zh, zh))
+    return _finish1(a, b, (zh >= 0.0) & (xl == xl))
+
+
+@_jit
+def _abs_rev_all(zl, zh, xl, xh):
+    zl0 = _smax(zl, 0.0)
+    a, b = _hull2(xl, xh, -zh, -zl0, zl0, zh)
+    return _finish1(a, b, (zh >= 0.0) & (xl == xl))
+
+
+@_jit
+def _sign_rev_all(zl, zh, xl, xh):
+    neg = (zl <= -1.0) & (zh >= -1.0) & (xl < 0.0)  # some x < 0
+    zer = (zl <= 0.0) & (zh >= 0.0) & (xl <= 0.0) & (xh >= 0.0)  # x = 0
+    pos = (zl <= 1.0) & (zh >= 1.0) & (xh > 0.0)  # some x > 0
+    lo = xl if neg else (0.0 if zer else (_smax(xl, 0.0) if pos else NAN))
+    hi = xh if pos else (0.0 if zer else (_smin(xh, 0.0) if neg else NAN))
+    return lo, hi
+
+
+@_jit
+def _floor_rev_all(zl, zh, xl, xh):
+    # floor(x) = k  <=>  k <= x < k + 1, for the integers k in Z
+    kl = np.ceil(zl)
+    kh = np.floor(zh)
+    a = _smax(xl, kl)
+    b = xh if np.floor(xh) <= kh else add_up(kh, 1.0)
+    ok = (zl == zl) & (xl == xl) & (kl <= kh) & (np.floor(a) <= kh)  # a < kh + 1, exactly
+    return _finish1(a, b, ok)
+
+
+@_jit
+def _ceil_rev_all(zl, zh, xl, xh):
+    # ceil(x) = k  <=>  k - 1 < x <= k, for the integers k in Z
+    kl = np.ceil(zl)
+    kh = np.floor(zh)
+    b = _smin(xh, kh)
+    a = xl if np.ceil(xl) >= kl else sub_dn(kl, 1.0)
+    ok = (zl == zl) & (xl == xl) & (kl <= kh) & (np.ceil(b) >= kl)  # b > kl - 1, exactly
+    return _finish1(a, b, ok)
+
+
+@ufunc(4)
+def _neg_rev_lo(zl, zh, xl, xh):
+    return _neg_rev_all(zl, zh, xl, xh)[0]
+
+
+@ufunc(4)
+def _neg_rev_hi(zl, zh, xl, xh):
+    return _neg_rev_all(zl, zh, xl, xh)[1]
+
+
+_NEG_REV = (_neg_rev_lo, _neg_rev_hi)
+
+
+@ufunc(4)
+def _sqr_rev_lo(zl, zh, xl, xh):
+    return _sqr_rev_all(zl, zh, xl, xh)[0]
+
+
+@ufunc(4)
+def _sqr_rev_hi(zl, zh, xl, xh):
+    return _sqr_rev_all(zl, zh, xl, xh)[1]
+
+
+_SQR_REV = (_sqr_rev_lo, _sqr_rev_hi)
+
+
+@ufunc(4)
+def _sqrt_rev_lo(zl, zh, xl, xh):
+    return _sqrt_rev_all(zl, zh, xl, xh)[0]
+
+
+@ufunc(4)
+def _sqrt_rev_hi(zl, zh, xl, xh):
+    return _sqrt_rev_all(zl, zh, xl, xh)[1]
+
+
+_SQRT_REV = (_sqrt_rev_lo, _sqrt_rev_hi)
+
+
+@ufunc(4)
+def _abs_rev_lo(zl, zh, xl, xh):
+    return _abs_rev_all(zl, zh, xl, xh)[0]
+
+
+@ufunc(4)
+def _abs_rev_hi(zl, zh, xl, xh):
+    return _abs_rev_all(zl, zh, xl, xh)[1]
+
+
+_ABS_REV = (_abs_rev_lo, _abs_rev_hi)
+
+
+@ufunc(4)
+def _sign_rev_lo(zl, zh, xl, xh):
+    return _sign_rev_all(zl, zh, xl, xh)[0]
+
+
+@ufunc(4)
+def _sign_rev_hi(zl, zh, xl, xh):
+    return _sign_rev_all(zl, zh, xl, xh)[1]
+
+
+_SIGN_REV = (_sign_rev_lo, _sign_rev_hi)
+
+
+@ufunc(4)
+def _floor_rev_lo(zl, zh, xl, xh):
+    return _floor_rev_all(zl, zh, xl, xh)[0]
+
+
+@ufunc(4)
+def _floor_rev_hi(zl, zh, xl, xh):
+    return _floor_rev_all(zl, zh, xl, xh)[1]
+
+
+_FLOOR_REV = (_floor_rev_lo, _floor_rev_hi)
+
+
+@ufunc(4)
+def _ceil_rev_lo(zl, zh, xl, xh):
+    return _ceil_rev_all(zl, zh, xl, xh)[0]
+
+
+@ufunc(4)
+def _ceil_rev_hi(zl, zh, xl, xh):
+    return _ceil_rev_all(zl, zh, xl, xh)[1]
+
+
+_CEIL_REV = (_ceil_rev_lo, _ceil_rev_hi)
+
+
+# Element kernels with the gufunc calling convention (outputs are 1-element arrays): the
+# binary ones run the public functions; all serve compiled callers through ``.scalar``.
 @gufunc(6, 4)
 def _add_rev(zl, zh, xl, xh, yl, yh, xlo, xhi, ylo, yhi):
-    # x in Z - Y, then y in Z - X'
-    if zl == zl and xl == xl and yl == yl:
-        a, b = _meet(xl, xh, sub_dn(zl, yh), sub_up(zh, yl))
-        if a <= b:
-            c, d = _meet(yl, yh, sub_dn(zl, b), sub_up(zh, a))
-            if c <= d:
-                xlo[0] = a
-                xhi[0] = b
-                ylo[0] = c
-                yhi[0] = d
-                return
-    xlo[0] = NAN
-    xhi[0] = NAN
-    ylo[0] = NAN
-    yhi[0] = NAN
+    xlo[0], xhi[0], ylo[0], yhi[0] = _add_rev_all(zl, zh, xl, xh, yl, yh)
 
 
 @gufunc(6, 4)
 def _sub_rev(zl, zh, xl, xh, yl, yh, xlo, xhi, ylo, yhi):
-    # z = x - y: x in Z + Y, then y in X' - Z
-    if zl == zl and xl == xl and yl == yl:
-        a, b = _meet(xl, xh, add_dn(zl, yl), add_up(zh, yh))
-        if a <= b:
-            c, d = _meet(yl, yh, sub_dn(a, zh), sub_up(b, zl))
-            if c <= d:
-                xlo[0] = a
-                xhi[0] = b
-                ylo[0] = c
-                yhi[0] = d
-                return
-    xlo[0] = NAN
-    xhi[0] = NAN
-    ylo[0] = NAN
-    yhi[0] = NAN
+    xlo[0], xhi[0], ylo[0], yhi[0] = _sub_rev_all(zl, zh, xl, xh, yl, yh)
 
 
 @gufunc(6, 4)
 def _mul_rev(zl, zh, xl, xh, yl, yh, xlo, xhi, ylo, yhi):
-    # z = x*y: x in X ∩ mulRevToPair(Y, Z) (two pieces), then y in Y ∩ mulRevToPair(X', Z).
-    # One loop over the two passes (roles swapped) keeps a single inlined copy of _div_pair.
-    if zl == zl and xl == xl and yl == yl:
-        al = xl
-        ah = xh
-        bl = yl
-        bh = yh
-        for _ in range(2):
-            l1, h1, l2, h2 = _div_pair(zl, zh, bl, bh)
-            a, b = _hull_meet2(al, ah, l1, h1, l2, h2)
-            if not a <= b:
-                al = NAN
-                break
-            al = bl
-            ah = bh
-            bl = a
-            bh = b
-        if al == al:  # after the two passes: (al, ah) = x', (bl, bh) = y'
-            xlo[0] = al
-            xhi[0] = ah
-            ylo[0] = bl
-            yhi[0] = bh
-            return
-    xlo[0] = NAN
-    xhi[0] = NAN
-    ylo[0] = NAN
-    yhi[0] = NAN
+    xlo[0], xhi[0], ylo[0], yhi[0] = _mul_rev_all(zl, zh, xl, xh, yl, yh)
 
 
 @gufunc(6, 4)
 def _div_rev(zl, zh, xl, xh, yl, yh, xlo, xhi, ylo, yhi):
-    # z = x/y (y != 0): x in X ∩ Z*Y, then y in Y ∩ {y : exists z in Z, y*z in X'}, y != 0
-    if zl == zl and xl == xl and yl == yl and not (yl == 0.0 and yh == 0.0):
-        pl, ph = _mul_lohi(zl, zh, yl, yh)
-        a, b = _meet(xl, xh, pl, ph)
-        if a <= b:
-            l1, h1, l2, h2 = _div_pair(a, b, zl, zh)
-            c, d = _hull_meet2(yl, yh, l1, h1, l2, h2)
-            if c <= d and not (c == 0.0 and d == 0.0):
-                xlo[0] = a
-                xhi[0] = b
-                ylo[0] = c
-                yhi[0] = d
-                return
-    xlo[0] = NAN
-    xhi[0] = NAN
-    ylo[0] = NAN
-    yhi[0] = NAN
+    xlo[0], xhi[0], ylo[0], yhi[0] = _div_rev_all(zl, zh, xl, xh, yl, yh)
+
+
+@gufunc(6, 4)
+def _min_rev(zl, zh, xl, xh, yl, yh, xlo, xhi, ylo, yhi):
+    xlo[0], xhi[0], ylo[0], yhi[0] = _min_rev_all(zl, zh, xl, xh, yl, yh)
+
+
+@gufunc(6, 4)
+def _max_rev(zl, zh, xl, xh, yl, yh, xlo, xhi, ylo, yhi):
+    xlo[0], xhi[0], ylo[0], yhi[0] = _max_rev_all(zl, zh, xl, xh, yl, yh)
 
 
 @gufunc(4)
 def _neg_rev(zl, zh, xl, xh, lo, hi):
-    a, b = _meet(xl, xh, -zh, -zl)
-    if a <= b and zl == zl and xl == xl:
-        lo[0] = a
-        hi[0] = b
-    else:
-        lo[0] = NAN
-        hi[0] = NAN
+    lo[0], hi[0] = _neg_rev_all(zl, zh, xl, xh)
 
 
 @gufunc(4)
 def _sqr_rev(zl, zh, xl, xh, lo, hi):
-    if zh >= 0.0 and xl == xl:  # false when Z is empty or negative
-        sl = sqrt_dn(_bmax(zl, 0.0))
-        sh = sqrt_up(zh)
-        a, b = _hull_meet2(xl, xh, -sh, -sl, sl, sh)
-        if a <= b:
-            lo[0] = a
-            hi[0] = b
-            return
-    lo[0] = NAN
-    hi[0] = NAN
+    lo[0], hi[0] = _sqr_rev_all(zl, zh, xl, xh)
 
 
 @gufunc(4)
 def _sqrt_rev(zl, zh, xl, xh, lo, hi):
-    if zh >= 0.0 and xl == xl:
-        zl0 = _bmax(zl, 0.0)
-        a, b = _meet(xl, xh, _bmax(mul_dn(zl0, zl0), 0.0), mul_up(zh, zh))
-        if a <= b:
-            lo[0] = a
-            hi[0] = b
-            return
-    lo[0] = NAN
-    hi[0] = NAN
+    lo[0], hi[0] = _sqrt_rev_all(zl, zh, xl, xh)
 
 
 @gufunc(4)
 def _abs_rev(zl, zh, xl, xh, lo, hi):
-    if zh >= 0.0 and xl == xl:
-        zl0 = _bmax(zl, 0.0)
-        a, b = _hull_meet2(xl, xh, -zh, -zl0, zl0, zh)
-        if a <= b:
-            lo[0] = a
-            hi[0] = b
-            return
-    lo[0] = NAN
-    hi[0] = NAN
+    lo[0], hi[0] = _abs_rev_all(zl, zh, xl, xh)
+
+
+@gufunc(4)
+def _sign_rev(zl, zh, xl, xh, lo, hi):
+    lo[0], hi[0] = _sign_rev_all(zl, zh, xl, xh)
+
+
+@gufunc(4)
+def _floor_rev(zl, zh, xl, xh, lo, hi):
+    lo[0], hi[0] = _floor_rev_all(zl, zh, xl, xh)
+
+
+@gufunc(4)
+def _ceil_rev(zl, zh, xl, xh, lo, hi):
+    lo[0], hi[0] = _ceil_rev_all(zl, zh, xl, xh)
 
 
 @_int_gufunc(4)
@@ -830,141 +1062,57 @@ def _pown_rev(zl, zh, xl, xh, n, lo, hi):
         h1 = -sl
         l2 = sl
         h2 = sh
-    a, b = _hull_meet2(xl, xh, l1, h1, l2, h2)
-    if a <= b:
+    a, b = _hull2(xl, xh, l1, h1, l2, h2)
+    if a <= b:  # false when empty (NaN)
         lo[0] = a
         hi[0] = b
-
-
-@gufunc(6, 4)
-def _min_rev(zl, zh, xl, xh, yl, yh, xlo, xhi, ylo, yhi):
-    # _bmin(x, y) in Z: (x in Z and some y >= x) or (some y in Y ∩ Z with y <= x)
-    if zl == zl and xl == xl and yl == yl:
-        yz = _bmax(yl, zl) <= _bmin(yh, zh)
-        a, b = _hull_meet2(xl, xh, zl, _bmin(zh, yh),
-                           _bmax(yl, zl) if yz else INF, INF if yz else -INF)
-        if a <= b:
-            xz = _bmax(a, zl) <= _bmin(b, zh)
-            c, d = _hull_meet2(yl, yh, zl, _bmin(zh, b),
-                               _bmax(a, zl) if xz else INF, INF if xz else -INF)
-            if c <= d:
-                xlo[0] = a
-                xhi[0] = b
-                ylo[0] = c
-                yhi[0] = d
-                return
-    xlo[0] = NAN
-    xhi[0] = NAN
-    ylo[0] = NAN
-    yhi[0] = NAN
-
-
-@gufunc(6, 4)
-def _max_rev(zl, zh, xl, xh, yl, yh, xlo, xhi, ylo, yhi):
-    # _bmax(x, y) in Z: (x in Z and some y <= x) or (some y in Y ∩ Z with y >= x)
-    if zl == zl and xl == xl and yl == yl:
-        yz = _bmax(yl, zl) <= _bmin(yh, zh)
-        a, b = _hull_meet2(xl, xh, _bmax(zl, yl), zh,
-                           -INF if yz else INF, _bmin(yh, zh) if yz else -INF)
-        if a <= b:
-            xz = _bmax(a, zl) <= _bmin(b, zh)
-            c, d = _hull_meet2(yl, yh, _bmax(zl, a), zh,
-                               -INF if xz else INF, _bmin(b, zh) if xz else -INF)
-            if c <= d:
-                xlo[0] = a
-                xhi[0] = b
-                ylo[0] = c
-                yhi[0] = d
-                return
-    xlo[0] = NAN
-    xhi[0] = NAN
-    ylo[0] = NAN
-    yhi[0] = NAN
-
-
-@gufunc(4)
-def _sign_rev(zl, zh, xl, xh, lo, hi):
-    a = INF
-    b = -INF
-    if zl == zl and xl == xl:
-        if zl <= -1.0 <= zh and xl < 0.0:  # x < 0
-            a = xl
-            b = _bmin(xh, 0.0)
-        if zl <= 0.0 <= zh and xl <= 0.0 <= xh:  # x = 0
-            a = _bmin(a, 0.0)
-            b = _bmax(b, 0.0)
-        if zl <= 1.0 <= zh and xh > 0.0:  # x > 0
-            a = _bmin(a, _bmax(xl, 0.0))
-            b = xh
-    if a <= b:
-        lo[0] = a
-        hi[0] = b
-    else:
-        lo[0] = NAN
-        hi[0] = NAN
-
-
-@gufunc(4)
-def _floor_rev(zl, zh, xl, xh, lo, hi):
-    # floor(x) = k  <=>  k <= x < k + 1, for the integers k in Z
-    lo[0] = NAN
-    hi[0] = NAN
-    if zl != zl or xl != xl:
-        return
-    kl = np.ceil(zl)
-    kh = np.floor(zh)
-    a = _bmax(xl, kl)
-    if kl > kh or a > xh or np.floor(a) > kh:  # the last test: a >= kh + 1 (exact)
-        return
-    lo[0] = a
-    hi[0] = xh if np.floor(xh) <= kh else add_up(kh, 1.0)
-
-
-@gufunc(4)
-def _ceil_rev(zl, zh, xl, xh, lo, hi):
-    # ceil(x) = k  <=>  k - 1 < x <= k, for the integers k in Z
-    lo[0] = NAN
-    hi[0] = NAN
-    if zl != zl or xl != xl:
-        return
-    kl = np.ceil(zl)
-    kh = np.floor(zh)
-    b = _bmin(xh, kh)
-    if kl > kh or b < xl or np.ceil(b) < kl:  # the last test: b <= kl - 1 (exact)
-        return
-    lo[0] = xl if np.ceil(xl) >= kl else sub_dn(kl, 1.0)
-    hi[0] = b
 
 
 # ----------------------------------------------------------------------------------------
 # public API
 # ----------------------------------------------------------------------------------------
-def _unary(kernel, x: IntervalLike, out: Interval | None) -> Interval:
+_Bounds = tuple[np.ndarray, ...]
+
+
+def _apply(kernels: tuple, ins: _Bounds, outs: _Bounds | None) -> _Bounds:
+    """Run one ufunc per output bound. With ``outs`` the bounds are written there; when an
+    output overlaps an input (an in-place contraction) every bound is computed first."""
+    if outs is None:
+        return tuple(k(*ins) for k in kernels)
+    if _bany(np.may_share_memory(o, i) for o in outs for i in ins):
+        res = [k(*ins) for k in kernels]
+        for o, r in zip(outs, res, strict=True):
+            np.copyto(o, r)
+    else:
+        for k, o in zip(kernels, outs, strict=True):
+            k(*ins, out=o)
+    return outs
+
+
+def _unary(kernels: tuple, x: IntervalLike, out: Interval | None) -> Interval:
     x = as_interval(x)
-    if out is None:
-        return Interval._new(*kernel(x.lo, x.hi))
-    kernel(x.lo, x.hi, out.lo, out.hi)
-    return out
+    lo, hi = _apply(kernels, (x.lo, x.hi), None if out is None else (out.lo, out.hi))
+    return out if out is not None else Interval._new(lo, hi)
 
 
-def _binary(kernel, x: IntervalLike, y: IntervalLike, out: Interval | None) -> Interval:
+def _binary(kernels: tuple, x: IntervalLike, y: IntervalLike, out: Interval | None) -> Interval:
     x, y = as_interval(x), as_interval(y)
-    if out is None:
-        return Interval._new(*kernel(x.lo, x.hi, y.lo, y.hi))
-    kernel(x.lo, x.hi, y.lo, y.hi, out.lo, out.hi)
-    return out
+    lo, hi = _apply(kernels, (x.lo, x.hi, y.lo, y.hi),
+                    None if out is None else (out.lo, out.hi))
+    return out if out is not None else Interval._new(lo, hi)
 
 
-def _rev1(kernel, z: IntervalLike, x: IntervalLike, out: Interval | None) -> Interval:
+def _rev1(kernels: tuple, z: IntervalLike, x: IntervalLike, out: Interval | None) -> Interval:
     z, x = as_interval(z), as_interval(x)
-    if out is None:
-        return Interval._new(*kernel(z.lo, z.hi, x.lo, x.hi))
-    kernel(z.lo, z.hi, x.lo, x.hi, out.lo, out.hi)
-    return out
+    lo, hi = _apply(kernels, (z.lo, z.hi, x.lo, x.hi),
+                    None if out is None else (out.lo, out.hi))
+    return out if out is not None else Interval._new(lo, hi)
 
 
 def _rev2(kernel, z: IntervalLike, x: IntervalLike, y: IntervalLike,
           out: tuple[Interval, Interval] | None) -> tuple[Interval, Interval]:
+    """A binary backward operator: one gufunc computing the four bounds per element (its
+    select-based body is cheaper than four ufuncs that would each redo the whole work)."""
     z, x, y = as_interval(z), as_interval(x), as_interval(y)
     if out is None:
         xl, xh, yl, yh = kernel(z.lo, z.hi, x.lo, x.hi, y.lo, y.hi)
@@ -1002,7 +1150,7 @@ def _exponent_checked(n: ArrayLike) -> np.ndarray:
 
 def abs(x: IntervalLike, out: Interval | None = None) -> Interval:
     """``|x|`` (exact): ``abs([-3, 2]) = [0, 3]``."""
-    return _unary(_abs, x, out)
+    return _unary((_abs_lo, _abs_hi), x, out)
 
 
 def pown(x: IntervalLike, n: ArrayLike, out: Interval | None = None) -> Interval:
@@ -1023,32 +1171,32 @@ def pown(x: IntervalLike, n: ArrayLike, out: Interval | None = None) -> Interval
 
 def min(x: IntervalLike, y: IntervalLike, out: Interval | None = None) -> Interval:
     """Elementwise ``{min(a, b) : a in x, b in y}`` (exact)."""
-    return _binary(_min, x, y, out)
+    return _binary((_min_lo, _min_hi), x, y, out)
 
 
 def max(x: IntervalLike, y: IntervalLike, out: Interval | None = None) -> Interval:
     """Elementwise ``{max(a, b) : a in x, b in y}`` (exact)."""
-    return _binary(_max, x, y, out)
+    return _binary((_max_lo, _max_hi), x, y, out)
 
 
 def sign(x: IntervalLike, out: Interval | None = None) -> Interval:
     """Hull of the signs (-1, 0 or 1) taken over ``x``: ``sign([0, 2]) = [0, 1]``."""
-    return _unary(_sign, x, out)
+    return _unary((_sign_lo, _sign_hi), x, out)
 
 
 def floor(x: IntervalLike, out: Interval | None = None) -> Interval:
     """Hull of ``floor`` over ``x`` (exact): ``floor([-1.1, 2]) = [-2, 2]``."""
-    return _unary(_floor, x, out)
+    return _unary((_floor_lo, _floor_hi), x, out)
 
 
 def ceil(x: IntervalLike, out: Interval | None = None) -> Interval:
     """Hull of ``ceil`` over ``x`` (exact): ``ceil([-1.1, 2]) = [-1, 2]``."""
-    return _unary(_ceil, x, out)
+    return _unary((_ceil_lo, _ceil_hi), x, out)
 
 
 def trunc(x: IntervalLike, out: Interval | None = None) -> Interval:
     """Hull of rounding towards zero over ``x`` (exact): ``trunc([-1.9, 2.2]) = [-1, 2]``."""
-    return _unary(_trunc, x, out)
+    return _unary((_trunc_lo, _trunc_hi), x, out)
 
 
 def add_rev(z: IntervalLike, x: IntervalLike, y: IntervalLike,
@@ -1094,7 +1242,7 @@ def max_rev(z: IntervalLike, x: IntervalLike, y: IntervalLike,
 
 def neg_rev(z: IntervalLike, x: IntervalLike, out: Interval | None = None) -> Interval:
     """``x ∩ (-z)``: contract ``x`` with ``z = -x``."""
-    return _rev1(_neg_rev, z, x, out)
+    return _rev1(_NEG_REV, z, x, out)
 
 
 def sqr_rev(z: IntervalLike, x: IntervalLike, out: Interval | None = None) -> Interval:
@@ -1102,17 +1250,17 @@ def sqr_rev(z: IntervalLike, x: IntervalLike, out: Interval | None = None) -> In
 
     ``sqr_rev([1, 4], [0, 5]) = [1, 2]``, ``sqr_rev([1, 4], [-5, 5]) = [-2, 2]``.
     """
-    return _rev1(_sqr_rev, z, x, out)
+    return _rev1(_SQR_REV, z, x, out)
 
 
 def sqrt_rev(z: IntervalLike, x: IntervalLike, out: Interval | None = None) -> Interval:
     """Contract ``x`` with ``z = sqrt(x)``: ``x ∩ [_bmax(z, 0)**2]``."""
-    return _rev1(_sqrt_rev, z, x, out)
+    return _rev1(_SQRT_REV, z, x, out)
 
 
 def abs_rev(z: IntervalLike, x: IntervalLike, out: Interval | None = None) -> Interval:
     """Contract ``x`` with ``z = |x|``: ``abs_rev([1, 2], [-5, 1.5]) = [-2, 1.5]``."""
-    return _rev1(_abs_rev, z, x, out)
+    return _rev1(_ABS_REV, z, x, out)
 
 
 def pown_rev(z: IntervalLike, x: IntervalLike, n: ArrayLike,
@@ -1132,17 +1280,17 @@ def pown_rev(z: IntervalLike, x: IntervalLike, n: ArrayLike,
 
 def sign_rev(z: IntervalLike, x: IntervalLike, out: Interval | None = None) -> Interval:
     """Contract ``x`` with ``z = sign(x)``: ``sign_rev([1, 1], [-2, 3]) = [0, 3]``."""
-    return _rev1(_sign_rev, z, x, out)
+    return _rev1(_SIGN_REV, z, x, out)
 
 
 def floor_rev(z: IntervalLike, x: IntervalLike, out: Interval | None = None) -> Interval:
     """Contract ``x`` with ``z = floor(x)``: ``floor_rev([1, 2], [0, 10]) = [1, 3]``."""
-    return _rev1(_floor_rev, z, x, out)
+    return _rev1(_FLOOR_REV, z, x, out)
 
 
 def ceil_rev(z: IntervalLike, x: IntervalLike, out: Interval | None = None) -> Interval:
     """Contract ``x`` with ``z = ceil(x)``: ``ceil_rev([1, 2], [0, 10]) = [0, 2]``."""
-    return _rev1(_ceil_rev, z, x, out)
+    return _rev1(_CEIL_REV, z, x, out)
 
 
 @gufunc(4, 4)

@@ -125,6 +125,7 @@ def _div_hi(al, ah, bl, bh):
 @ufunc(2)
 def _sqr_lo(al, ah):
     r = mul_dn(al, al) if al >= 0.0 else (mul_dn(ah, ah) if ah <= 0.0 else 0.0)
+    r = r if r > 0.0 else 0.0  # an underflowing square steps below 0: squares are >= 0
     return NAN if al != al else r
 
 
