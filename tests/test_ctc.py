@@ -452,9 +452,6 @@ def test_nonlinear_contractions_by_hand():
     assert np.all(r == Interval([0, 1], [1, 2]))
 
 
-@pytest.mark.xfail(strict=True, reason="x ** 2.0 builds IEEE pow(x, 2) (defined for x >= 0 "
-                   "only) while the parser reads x^2.0 as sqr and interval pow(x, 2.0) is pown: "
-                   "the solution x = -2 of x ** 2.0 == 4 is lost")
 def test_float_integer_exponent_keeps_negative_solutions():
     r = CtcFwdBwd([x**2.0 == 4], ["x"])(Interval([-3], [3]))
     assert mp_in(-2, float(r.lo[0]), float(r.hi[0]))
@@ -527,10 +524,6 @@ def test_fixpoint_converges_beyond_one_pass():
     assert capped.iterations == 3
 
 
-@pytest.mark.xfail(strict=True, reason="shrink_ratio counts an infinite width as 1e300, so a box "
-                   "with one unbounded component has a relative shrink of ~1e-300 whatever its "
-                   "other components do: Fixpoint stops after ONE pass (y = z/2, z = y/2 stays "
-                   "at [0, 5] x [0, 2.5] instead of converging to [0, ~0]^2)")
 def test_fixpoint_with_an_unbounded_component():
     ctc = CtcFwdBwd([y == 0.5 * z, z == 0.5 * y, u >= -1], ["y", "z", "u"])
     r = Fixpoint(ctc, ratio=1e-3)(Interval([0, 0, -INF], [10, 10, INF]))
@@ -545,10 +538,6 @@ def test_propagate_converges_with_an_unbounded_component():
     assert float(res["u"].lo) == -1.0 and float(res["u"].hi) == INF
 
 
-@pytest.mark.xfail(strict=True, reason="the propagation queue never re-queues the node being "
-                   "revised (engine.py: 'if j != i'), so a node whose output slot is also its "
-                   "argument (x == sqrt(x)) is revised once: x stays at [0, 3.17] although the "
-                   "slot shrank by 68% (Fixpoint(CtcFwdBwd) reaches [0, 1.001])")
 def test_propagate_revises_a_self_referencing_node_again():
     res = propagate([x == Op("sqrt", (x,))], domains={"x": Interval(0, 10)})
     assert float(res["x"].hi) <= 1.01
@@ -666,9 +655,6 @@ def test_inconsistent_csps(cons):
     assert np.all(r.is_empty())
 
 
-@pytest.mark.xfail(strict=True, reason="propagate drops an EMPTY domain override: "
-                   "lo[s] = max(lo[s], nan) is lo[s] with Python's max, so the CSP is reported "
-                   "consistent with x entire")
 def test_propagate_with_an_empty_domain_is_inconsistent():
     res = propagate([x + y == 1], domains={"x": Interval.empty()})
     assert res.consistent is False

@@ -9,6 +9,8 @@ directions: the work per time step does not grow with the horizon.
 
 from __future__ import annotations
 
+import math
+
 import numba as nb
 import numpy as np
 
@@ -39,11 +41,12 @@ _mul_lo, _mul_hi, _div_lo, _div_hi = (ar._mul_lo.scalar, ar._mul_hi.scalar, ar._
                                       ar._div_hi.scalar)
 _sqr_lo, _sqr_hi, _sqrt_lo, _sqrt_hi = (ar._sqr_lo.scalar, ar._sqr_hi.scalar,
                                         ar._sqrt_lo.scalar, ar._sqrt_hi.scalar)
-_f_exp, _f_log, _f_sinh, _f_cosh = el._exp.scalar, el._log.scalar, el._sinh.scalar, el._cosh.scalar
-_f_tanh, _f_atan, _f_atan2, _f_pow = (el._tanh.scalar, el._atan.scalar, el._atan2.scalar,
-                                      el._pow.scalar)
-_f_sin, _f_cos, _f_tan, _f_asin, _f_acos = (tr._sin.scalar, tr._cos.scalar, tr._tan.scalar,
-                                            tr._asin.scalar, tr._acos.scalar)
+# bounds functions f(xl, xh, f(xl), f(xh)) -> (lo, hi), given libm values at the bounds
+_f_exp, _f_log, _f_sinh, _f_cosh = el._exp.bounds, el._log.bounds, el._sinh.bounds, el._cosh.bounds
+_f_tanh, _f_atan, _f_asin, _f_acos = (el._tanh.bounds, el._atan.bounds, tr._asin.bounds,
+                                      tr._acos.bounds)
+_f_atan2, _f_pow = el._atan2.scalar, el._pow.scalar
+_f_sin, _f_cos, _f_tan = tr._sin.scalar, tr._cos.scalar, tr._tan.scalar
 _f_abs, _f_sign, _f_floor, _f_ceil = (al._abs.scalar, al._sign.scalar, al._floor.scalar,
                                       al._ceil.scalar)
 _f_pown, _f_min, _f_max = al._pown.scalar, al._min.scalar, al._max.scalar
@@ -91,9 +94,9 @@ def _forward(code, xl, xh, yl, yh, p, buf):
     elif code == POWN:
         _f_pown(xl, xh, np.int64(p), o0, o1)
     elif code == EXP:
-        _f_exp(xl, xh, o0, o1)
+        buf[0], buf[1] = _f_exp(xl, xh, math.exp(xl), math.exp(xh))
     elif code == LOG:
-        _f_log(xl, xh, o0, o1)
+        buf[0], buf[1] = _f_log(xl, xh, math.log(xl), math.log(xh))
     elif code == SIN:
         _f_sin(xl, xh, o0, o1)
     elif code == COS:
@@ -101,17 +104,19 @@ def _forward(code, xl, xh, yl, yh, p, buf):
     elif code == TAN:
         _f_tan(xl, xh, o0, o1)
     elif code == ASIN:
-        _f_asin(xl, xh, o0, o1)
-    elif code == ACOS:
-        _f_acos(xl, xh, o0, o1)
+        buf[0], buf[1] = _f_asin(xl, xh, math.asin(xl), math.asin(xh))
+    elif code == ACOS:  # asin is only used where |x| <= 1/2
+        buf[0], buf[1] = _f_acos(xl, xh, math.acos(xl), math.acos(xh),
+                                 math.asin(xl) if abs(xl) <= 0.5 else 0.0,
+                                 math.asin(xh) if abs(xh) <= 0.5 else 0.0)
     elif code == ATAN:
-        _f_atan(xl, xh, o0, o1)
+        buf[0], buf[1] = _f_atan(xl, xh, math.atan(xl), math.atan(xh))
     elif code == SINH:
-        _f_sinh(xl, xh, o0, o1)
+        buf[0], buf[1] = _f_sinh(xl, xh, math.sinh(xl), math.sinh(xh))
     elif code == COSH:
-        _f_cosh(xl, xh, o0, o1)
+        buf[0], buf[1] = _f_cosh(xl, xh, math.cosh(xl), math.cosh(xh))
     elif code == TANH:
-        _f_tanh(xl, xh, o0, o1)
+        buf[0], buf[1] = _f_tanh(xl, xh, math.tanh(xl), math.tanh(xh))
     elif code == ABS:
         _f_abs(xl, xh, o0, o1)
     elif code == SIGN:
@@ -238,6 +243,8 @@ def propagate_kernel(op, out, a, b, param, lo, hi, ptr, adj, queue, inq, state, 
         inq[i] = False
         evals += 1
         code, o, ia, ib = op[i], out[i], a[i], b[i]
+        # the node itself is revised again only when it reads what it writes
+        again = o == ia or o == ib or ia == ib
         xl, xh = lo[ia], hi[ia]
         yl, yh = (lo[ib], hi[ib]) if ib >= 0 else (0.0, 0.0)
         _forward(code, xl, xh, yl, yh, param[i], buf)
@@ -272,7 +279,7 @@ def propagate_kernel(op, out, a, b, param, lo, hi, ptr, adj, queue, inq, state, 
             s = changed[c]
             for k in range(ptr[s], ptr[s + 1]):
                 j = adj[k]
-                if j != i and not inq[j]:
+                if (j != i or again) and not inq[j]:
                     inq[j] = True
                     tail = head + count
                     queue[tail if tail < n else tail - n] = j

@@ -94,8 +94,11 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
         if name not in tape.slot_of:
             raise ValueError(f"unknown variable {name!r}")
         s = tape.slot_of[name]
-        lo[s] = max(lo[s], float(dom.lo))
-        hi[s] = min(hi[s], float(dom.hi))
+        if bool(dom.is_empty()):
+            lo[s] = hi[s] = np.nan
+        else:
+            lo[s] = max(lo[s], float(dom.lo))
+            hi[s] = min(hi[s], float(dom.hi))
     budget = 10_000 * max(tape.n_nodes, 1) if max_evaluations is None else max_evaluations
     ptr, adj = slot_users(tape)
     n = tape.n_nodes

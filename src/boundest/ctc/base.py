@@ -117,21 +117,21 @@ class Union(Contractor):
 
 
 def shrink_ratio(before: Interval, after: Interval) -> np.ndarray:
-    """Per-box relative decrease of the summed finite widths (1 when a box became empty)."""
-    def size(x: Interval) -> np.ndarray:
-        w = np.where(np.isfinite(x.width()), x.width(), 1e300)
-        return w if w.ndim == 0 else w.sum(axis=-1)
-
-    b, a = size(before), size(after)
+    """Per box, the largest relative shrink of a component: ``(w_before - w_after) / w_before``;
+    1 when a component lost an infinite bound or the box became empty, 0 when nothing moved."""
+    wb, wa = before.width(), after.width()
     with np.errstate(invalid="ignore", divide="ignore"):
-        r = np.where(b > 0, (b - a) / b, 0.0)
-    empty_now = after.is_empty() if after.ndim == 0 else after.is_empty().any(axis=-1)
-    return np.where(empty_now, 1.0, np.nan_to_num(r, nan=1.0))
+        r = np.where(np.isinf(wb), np.where((before.lo != after.lo) | (before.hi != after.hi),
+                                            1.0, 0.0),
+                     np.where(wb > 0, (wb - wa) / wb, 0.0))
+    r = np.where(after.is_empty() & ~before.is_empty(), 1.0, np.nan_to_num(r, nan=0.0))
+    return r if r.ndim == 0 else r.max(axis=-1)
 
 
 class Fixpoint(Contractor):
-    """Repeat a contractor until no box shrinks by more than ``ratio`` (relative, in summed
-    width) or ``max_iter`` passes have run. ``iterations`` holds the count of the last call."""
+    """Repeat a contractor until no component of any box shrinks by more than ``ratio`` of its
+    width (``shrink_ratio``) or ``max_iter`` passes have run. ``iterations`` holds the count of
+    the last call."""
 
     def __init__(self, ctc: Contractor, ratio: float = 1e-3, max_iter: int = 1000) -> None:
         if not 0.0 <= ratio < 1.0:

@@ -75,8 +75,11 @@ class Expr:
         return self
 
     def __pow__(self, o: object) -> Expr:
-        if isinstance(o, numbers.Integral) and not isinstance(o, bool):
-            return Op("sqr", (self,)) if int(o) == 2 else Op("pown", (self,), int(o))
+        # an integer-valued exponent (2 or 2.0) is the integer power, defined for any sign of
+        # the base; IEEE pow (x >= 0 only) would lose the negative solutions of x**2.0 == 4
+        if isinstance(o, numbers.Real) and not isinstance(o, bool) and float(o).is_integer():
+            n = int(o)
+            return Op("sqr", (self,)) if n == 2 else Op("pown", (self,), n)
         return Op("pow", (self, as_expr(o)))
 
     def __rpow__(self, o: object) -> Expr:
@@ -152,7 +155,7 @@ class VarFamily:
     """
 
     def __init__(self, name: str) -> None:
-        if not name.isidentifier():
+        if not isinstance(name, str) or not name.isidentifier():
             raise ValueError(f"invalid variable family name: {name!r}")
         self.name = name
         self._members: dict[tuple[int, ...], Var] = {}
@@ -183,6 +186,9 @@ class Op(Expr):
             raise ValueError(f"unknown operation {name!r}")
         if len(args) != arity:
             raise ValueError(f"{name} takes {arity} argument(s), got {len(args)}")
+        if name == "pown" and not (isinstance(param, numbers.Integral)
+                                   and not isinstance(param, bool)):
+            raise ValueError(f"pown needs an integer exponent, got {param!r}")
         self.name, self.args, self.param = name, args, param
 
     def __str__(self) -> str:

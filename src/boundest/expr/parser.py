@@ -120,7 +120,7 @@ class _Build(Transformer):
         tok = items[-1]
         if tok.type == "INF":
             return (tok, sign * np.inf, None)
-        iv = decimal_interval(str(tok))
+        iv = self._decimal(tok)
         return (tok, float(iv.lo) if sign > 0 else -float(iv.hi),
                 float(iv.hi) if sign > 0 else -float(iv.lo))
 
@@ -140,8 +140,14 @@ class _Build(Transformer):
         self.vars[str(name)] = self.model.declare(str(name), dom)
 
     # expressions
+    def _decimal(self, tok: Token) -> Interval:
+        try:
+            return decimal_interval(str(tok))
+        except ValueError as exc:
+            raise self._err(tok, str(exc)) from None
+
     def number(self, items):
-        return Const(decimal_interval(str(items[0])))
+        return Const(self._decimal(items[0]))
 
     def name(self, items):
         tok = items[0]
@@ -215,23 +221,50 @@ class _Build(Transformer):
         return self.model
 
 
+_READABLE = {"NAME": "a name", "NUMBER": "a number", "LB": "'[' or ']'", "RB": "']' or '['",
+             "INF": "'oo'", "_IN": "'in'", "_VARIABLES": "'Variables'",
+             "_CONSTRAINTS": "'Constraints'", "$END": "end of file"}
+
+
+def _expected(names: set[str]) -> str:
+    """The terminals a parser state accepts, as a reader would write them."""
+    out = []
+    for n in sorted(names):
+        if n in _READABLE:
+            out.append(_READABLE[n])
+            continue
+        try:
+            pattern = _parser.get_terminal(n).pattern
+        except KeyError:
+            out.append(n)
+            continue
+        out.append(repr(pattern.value) if pattern.type == "str" else n.lower())
+    return ", ".join(sorted(set(out)))
+
+
+def _end_position(text: str) -> tuple[int, int]:
+    """Line and column just after the last non-blank character."""
+    lines = text.rstrip().splitlines() or [""]
+    return len(lines), len(lines[-1]) + 1
+
+
 def parse_model(text: str, source: str = "<string>") -> Model:
     """Parse model text into a ``Model``; errors name ``source``, line and column."""
     try:
         tree = _parser.parse(text)
-    except UnexpectedEOF as exc:
-        lines = text.rstrip().splitlines() or [""]
-        raise ModelSyntaxError(f"{source}:{len(lines)}:{len(lines[-1]) + 1}: unexpected end "
-                               f"of file (expected one of {sorted(exc.expected)})") from None
     except UnexpectedCharacters as exc:
         raise ModelSyntaxError(f"{source}:{exc.line}:{exc.column}: unexpected character "
                                f"{text[exc.pos_in_stream]!r}") from None
     except UnexpectedInput as exc:
+        expected = getattr(exc, "expected", None) or getattr(exc, "accepts", None) or set()
+        hint = f" (expected {_expected(set(expected))})" if expected else ""
         tok = getattr(exc, "token", None)
-        what = f"unexpected {tok!s}" if tok is not None else "syntax error"
-        expected = getattr(exc, "expected", None) or getattr(exc, "accepts", None)
-        hint = f" (expected one of {sorted(expected)})" if expected else ""
-        raise ModelSyntaxError(f"{source}:{exc.line}:{exc.column}: {what}{hint}") from None
+        if isinstance(exc, UnexpectedEOF) or (tok is not None and tok.type == "$END"):
+            line, col = _end_position(text)
+            raise ModelSyntaxError(f"{source}:{line}:{col}: unexpected end of file{hint}"
+                                   ) from None
+        raise ModelSyntaxError(f"{source}:{exc.line}:{exc.column}: unexpected {tok!s}{hint}"
+                               ) from None
     try:
         return _Build(source).transform(tree)
     except VisitError as exc:

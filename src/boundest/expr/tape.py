@@ -128,6 +128,9 @@ class _Builder:
         return s
 
     def restrict(self, s: int, lo: float, hi: float) -> None:
+        if lo != lo or hi != hi:  # an empty domain (NaN bounds): Python's max would drop it
+            self.lo[s] = self.hi[s] = np.nan
+            return
         self.lo[s] = max(self.lo[s], lo)
         self.hi[s] = min(self.hi[s], hi)
 
@@ -196,8 +199,10 @@ def _close(bld: _Builder, merges: list[tuple[int, int]]) -> Tape:
     hi = np.full(len(roots), np.inf)
     for s in range(n):
         r = new_id[_find(parent, s)]
-        lo[r] = max(lo[r], bld.lo[s])
-        hi[r] = min(hi[r], bld.hi[s])
+        lo[r] = np.fmax(lo[r], bld.lo[s]) if lo[r] == lo[r] else lo[r]
+        hi[r] = np.fmin(hi[r], bld.hi[s]) if hi[r] == hi[r] else hi[r]
+        if bld.lo[s] != bld.lo[s]:  # an empty slot empties its merged class
+            lo[r] = hi[r] = np.nan
     empty = lo > hi
     lo[empty] = hi[empty] = np.nan
     uniq: dict[tuple, None] = {}
