@@ -244,7 +244,7 @@ def propagate_kernel(op, out, a, b, param, lo, hi, ptr, adj, queue, inq, state, 
         evals += 1
         code, o, ia, ib = op[i], out[i], a[i], b[i]
         # the node itself is revised again only when it reads what it writes
-        again = o == ia or o == ib or ia == ib
+        again = (o == ia) | (o == ib) | (ia == ib)
         xl, xh = lo[ia], hi[ia]
         yl, yh = (lo[ib], hi[ib]) if ib >= 0 else (0.0, 0.0)
         _forward(code, xl, xh, yl, yh, param[i], buf)
