@@ -5,16 +5,14 @@ arithmetic at 300 bits for huge exponents), must lie in the computed enclosure. 
 operators: points x in X (and y in Y) with z = f(x, y) computed exactly and Z a float interval
 around z (sometimes widened) must survive the contraction, and the results must be subsets of
 the inputs. Edge cases use values derived by hand; tightness is checked against independent
-exact references (Fractions, mpmath) and against the ITF1788 vectors at the end.
+exact references (Fractions, mpmath); tests/test_itf1788.py checks the ITF1788 vectors.
 """
 
 from __future__ import annotations
 
 import math
-import re
 import sys
 from fractions import Fraction
-from pathlib import Path
 
 import mpmath
 import numpy as np
@@ -717,112 +715,3 @@ def test_in_place_contraction():
     x = x0.copy()
     alg.abs(x, out=x)
     assert np.array_equal(x.lo, w.lo) and np.array_equal(x.hi, w.hi)
-
-
-# -------------------------------------------------------------------------------------------
-# ITF1788 vectors of these functions (a check of this module only; the full harness is
-# tests/test_itf1788.py)
-# -------------------------------------------------------------------------------------------
-
-_ITF_DIRS = (Path(__file__).parent / "itf1788", Path("/work/shared/itf1788"))
-_ITF_OPS = {"mulRev", "mulRevTen", "mulRevToPair", "sqrRev", "sqrRevBin", "absRev", "absRevBin",
-            "pownRev", "pownRevBin", "pown", "abs", "min", "max", "sign", "floor", "ceil",
-            "trunc"}
-_TOKEN = re.compile(r"\[[^\]]*\]|[^\s\[\]]+")
-
-
-def _num(s: str) -> float:
-    """An ITF1788 number: hex floats exactly, decimals as the nearest double (as the C++
-    literals of libieeep1788 they come from)."""
-    s = s.strip().lower()
-    if s in ("infinity", "+infinity", "inf"):
-        return INF
-    if s in ("-infinity", "-inf"):
-        return -INF
-    if "0x" in s:
-        return float.fromhex(s)
-    return float(s)
-
-
-def _interval(tok: str) -> Interval:
-    body = tok.strip()[1:-1].strip().lower()
-    if body == "empty":
-        return EMPTY
-    if body == "entire":
-        return ENTIRE
-    a, b = body.split(",")
-    return Interval(_num(a), _num(b))
-
-
-def _itf_vectors() -> list[tuple[str, str, list, list]]:
-    folder = next((d for d in _ITF_DIRS if d.is_dir()), None)
-    if folder is None:
-        return []
-    out = []
-    for path in sorted(folder.glob("*.itl")):
-        text = re.sub(r"/\*.*?\*/", lambda m: "\n" * m.group().count("\n"), path.read_text(),
-                      flags=re.S)  # drop comments, keep the line numbers
-        for lineno, line in enumerate(text.splitlines(), 1):
-            line = line.split("//")[0].strip().rstrip(";")
-            if "=" not in line or re.search(r"_(com|def|dac|trv|ill)\b", line):
-                continue
-            lhs, rhs = line.split("=")
-            toks = _TOKEN.findall(lhs)
-            if not toks or toks[0] not in _ITF_OPS:
-                continue
-            args = [_interval(t) if t.startswith("[") else int(t) for t in toks[1:]]
-            want = [_interval(t) for t in _TOKEN.findall(rhs)]
-            out.append((f"{path.stem}:{lineno}", toks[0], args, want))
-    return out
-
-
-ITF_VECTORS = _itf_vectors()
-
-
-def _itf_call(op: str, args: list) -> list[Interval]:
-    if op == "mulRev":
-        b, c = args
-        return [alg.mul_rev(c, ENTIRE, b)[0]]
-    if op == "mulRevTen":
-        b, c, x = args
-        return [alg.mul_rev(c, x, b)[0]]
-    if op == "mulRevToPair":
-        b, c = args
-        return list(alg.mul_rev_to_pair(c, b))
-    if op in ("sqrRev", "absRev"):
-        f = alg.sqr_rev if op == "sqrRev" else alg.abs_rev
-        return [f(args[0], ENTIRE)]
-    if op in ("sqrRevBin", "absRevBin"):
-        f = alg.sqr_rev if op == "sqrRevBin" else alg.abs_rev
-        return [f(args[0], args[1])]
-    if op == "pownRev":
-        return [alg.pown_rev(args[0], ENTIRE, args[1])]
-    if op == "pownRevBin":
-        return [alg.pown_rev(*args)]
-    return [getattr(alg, op)(*args)]
-
-
-def _itf_result(op: str, args: list, want: list[Interval]) -> tuple[bool, bool]:
-    got = _itf_call(op, args)
-    assert len(got) == len(want)
-    contained = all(valid(g) and subset(w, g) for g, w in zip(got, want, strict=True))
-    equal = all(
-        (is_empty(g) and is_empty(w)) or (float(g.lo) == float(w.lo) and float(g.hi) == float(w.hi))
-        for g, w in zip(got, want, strict=True))
-    return contained, equal
-
-
-@pytest.mark.skipif(not ITF_VECTORS, reason="ITF1788 vectors not found")
-@pytest.mark.parametrize("where, op, args, want", ITF_VECTORS, ids=[v[0] for v in ITF_VECTORS])
-def test_itf1788_vector(where, op, args, want):
-    contained, equal = _itf_result(op, args, want)
-    assert contained, (where, op, args, want, _itf_call(op, args))
-    assert equal, (where, op, args, want, _itf_call(op, args))  # tightest, as ITF1788 expects
-
-
-@pytest.mark.skipif(not ITF_VECTORS, reason="ITF1788 vectors not found")
-def test_itf1788_vector_count():
-    """Every operation of this module has its vectors found by the little parser."""
-    ops = {op for _, op, _, _ in ITF_VECTORS}
-    assert ops == _ITF_OPS
-    assert len(ITF_VECTORS) > 300

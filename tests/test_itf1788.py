@@ -70,6 +70,24 @@ def test_itf1788_sound(op: str) -> None:
                      f"fail:\n{lines}{more}")
 
 
+#: Operations whose every bare vector is the tightest result (no libm call involved): a
+#: regression test of their exactness, on top of soundness.
+TIGHTEST = ["abs", "absRev", "absRevBin", "add", "ceil", "cosRev", "div", "floor", "max", "min",
+            "mul", "mulRev", "mulRevTen", "mulRevToPair", "neg", "pos", "pown", "pownRev",
+            "pownRevBin", "recip", "sign", "sinRev", "sqr", "sqrRev", "sqrRevBin", "sqrt", "sub",
+            "tanRev", "tanRevBin", "trunc", "convexHull", "intersection", "inf", "sup", "mid",
+            "mag", "mig", "wid", "rad"]
+
+
+@pytest.mark.parametrize("op", TIGHTEST)
+def test_itf1788_exact_operations_are_tightest(op: str) -> None:
+    r = _result(op)
+    _skip_if_not_run(r)
+    loose = [o for o in r.outcomes if o.status != "tight"]
+    lines = "\n".join(o.describe() for o in loose[:SHOWN])
+    assert not loose, f"{op}: {len(loose)} of {len(r.outcomes)} vectors not tightest:\n{lines}"
+
+
 @pytest.mark.parametrize("op", ["add", "sub", "mul", "div", "sqrt", "sqr"])
 def test_itf1788_basic_operations_tight(op: str) -> None:
     """Correctly rounded operations: each bound at most one float64 step from the tightest."""
