@@ -1,9 +1,12 @@
 """The exponential family, forward and backward: exp, log, sinh, cosh, tanh, their inverses,
 atan, atan2, pow (and exp2, exp10, expm1, log2, log10, log1p).
 
-Forward functions are monotone (or piecewise monotone) element kernels: each bound is a libm
-value at an end point, widened by ``libm_dn``/``libm_up`` (the assumed ``LIBM_ULPS`` error,
-shared/RIGOR.md) and then clamped with facts that hold exactly whatever the rounding:
+Forward functions are monotone (or piecewise monotone): each bound is a libm value at an end
+point, widened by the assumed ``LIBM_ULPS`` error (``libm_dn``/``libm_up``, shared/RIGOR.md) and
+then clamped with facts that hold exactly whatever the rounding. For the unary functions the
+libm values come from NumPy's ufunc on the whole bound arrays (SIMD code, SVML on AVX-512; SVML
+is documented at 4 ulps), and a compiled branch-free loop does the widening and clamping; atan2
+and pow are element kernels that call libm through Numba. The facts:
 
 * known ranges: ``exp >= 0``, ``cosh >= 1``, ``|tanh| <= 1``, ``|atan| <= pi/2`` (with the
   float enclosure ``[HALF_PI_LO, HALF_PI_HI]`` of pi/2), atan2 in the quadrant of its arguments;
@@ -27,15 +30,22 @@ import math
 
 import numba as nb
 import numpy as np
+from llvmlite import ir
+from numba import types
+from numba.extending import intrinsic
 from numpy.typing import ArrayLike
 
 from .core import Interval, as_interval
 from .rounding import (
+    ETA,
     INF,
+    LIBM_ULPS,
     MAX,
     NAN,
+    PHI,
     add_dn,
     add_up,
+    check_rounding_mode,
     div_dn,
     div_up,
     gufunc,
@@ -91,6 +101,10 @@ HALF_PI_HI = float.fromhex("0x1.921fb54442d19p+0")
 _ONE_MINUS = float.fromhex("0x1.fffffffffffffp-1")
 #: Exactly representable powers of ten 10**0 .. 10**22.
 _POW10 = np.array([float(10**k) for k in range(23)])
+
+#: The libm widening of ``rounding.libm_dn``/``libm_up``: relative and absolute parts.
+_LIBM_REL = (LIBM_ULPS + 1) * 2.0**-52
+_LIBM_ABS = LIBM_ULPS * ETA
 
 _jit = nb.njit(inline="always", cache=True)
 #: Larger helpers called from several kernels: compiled once (LLVM still inlines them).
@@ -148,160 +162,6 @@ def _log_up(x):
 
 
 @_jit
-def _exp2_exact(x):
-    """2**x when it is an exactly representable float (x integer in [-1074, 1023]), else NaN."""
-    if -1074.0 <= x <= 1023.0 and x == math.floor(x):
-        return math.ldexp(1.0, int(x))
-    return NAN
-
-
-@_jit
-def _exp2_dn(x):
-    e = _exp2_exact(x)
-    if e == e:
-        return e
-    r = libm_dn(math.pow(2.0, x))
-    return max(r, 1.0) if x > 0.0 else max(r, 0.0)
-
-
-@_jit
-def _exp2_up(x):
-    e = _exp2_exact(x)
-    if e == e:
-        return e
-    if x == -INF:
-        return 0.0
-    r = libm_up(math.pow(2.0, x))
-    return min(r, 1.0) if x < 0.0 else r
-
-
-@_jit
-def _exp10_exact(x):
-    """10**x for x integer in [0, 22] (exact floats), else NaN."""
-    if 0.0 <= x <= 22.0 and x == math.floor(x):
-        return _POW10[int(x)]
-    return NAN
-
-
-@_jit
-def _exp10_dn(x):
-    e = _exp10_exact(x)
-    if e == e:
-        return e
-    r = libm_dn(math.pow(10.0, x))
-    return max(r, 1.0) if x > 0.0 else max(r, 0.0)
-
-
-@_jit
-def _exp10_up(x):
-    e = _exp10_exact(x)
-    if e == e:
-        return e
-    if x == -INF:
-        return 0.0
-    r = libm_up(math.pow(10.0, x))
-    return min(r, 1.0) if x < 0.0 else r
-
-
-@_jit
-def _log2_exact(x):
-    """log2(x) for x > 0 an exact power of two, else NaN."""
-    m, e = math.frexp(x)
-    if m == 0.5:
-        return float(e - 1)
-    return NAN
-
-
-@_jit
-def _log2_dn(x):
-    e = _log2_exact(x)
-    if e == e:
-        return e
-    r = libm_dn(math.log2(x))
-    return max(r, 0.0) if x > 1.0 else r
-
-
-@_jit
-def _log2_up(x):
-    if x == 0.0:
-        return -INF
-    if x == INF:
-        return INF
-    e = _log2_exact(x)
-    if e == e:
-        return e
-    r = libm_up(math.log2(x))
-    return min(r, 0.0) if x < 1.0 else r
-
-
-@_jit
-def _log10_exact(x):
-    """log10(x) for x = 10**k, k in [0, 22], else NaN."""
-    if 1.0 <= x <= 1e22:
-        k = math.floor(math.log10(x) + 0.5)
-        if 0 <= k <= 22 and _POW10[k] == x:
-            return float(k)
-    return NAN
-
-
-@_jit
-def _log10_dn(x):
-    e = _log10_exact(x)
-    if e == e:
-        return e
-    r = libm_dn(math.log10(x))
-    return max(r, 0.0) if x > 1.0 else r
-
-
-@_jit
-def _log10_up(x):
-    if x == 0.0:
-        return -INF
-    e = _log10_exact(x)
-    if e == e:
-        return e
-    r = libm_up(math.log10(x))
-    return min(r, 0.0) if x < 1.0 else r
-
-
-@_jit
-def _expm1_dn(x):
-    if x == 0.0:
-        return 0.0
-    r = max(libm_dn(math.expm1(x)), x)  # expm1(x) >= x
-    return max(r, -1.0)
-
-
-@_jit
-def _expm1_up(x):
-    if x == 0.0:
-        return 0.0
-    if x == -INF:
-        return -1.0
-    r = libm_up(math.expm1(x))
-    return min(r, 0.0) if x < 0.0 else r
-
-
-@_jit
-def _log1p_dn(x):
-    """Lower bound of log1p(x), x > -1."""
-    if x == 0.0:
-        return 0.0
-    r = libm_dn(math.log1p(x))
-    return max(r, 0.0) if x > 0.0 else r
-
-
-@_jit
-def _log1p_up(x):
-    """Upper bound of log1p(x), x >= -1."""
-    if x == 0.0:
-        return 0.0
-    if x == -1.0:
-        return -INF
-    return min(libm_up(math.log1p(x)), x)  # log1p(x) <= x
-
-
-@_jit
 def _sinh_dn(x):
     r = libm_dn(math.sinh(x))
     return max(r, x) if x >= 0.0 else r  # sinh(x) >= x for x >= 0
@@ -344,34 +204,6 @@ def _tanh_up(x):
     if x <= 0.0:
         return min(r, 0.0)
     return min(min(r, x), 1.0)
-
-
-@_jit
-def _atan_dn(x):
-    if x == 0.0:
-        return 0.0
-    if x == INF:
-        return HALF_PI_LO
-    if x == -INF:
-        return -HALF_PI_HI
-    r = libm_dn(math.atan(x))
-    if x > 0.0:
-        return max(r, 0.0)
-    return max(max(r, x), -HALF_PI_HI)  # atan(x) >= x for x < 0
-
-
-@_jit
-def _atan_up(x):
-    if x == 0.0:
-        return 0.0
-    if x == INF:
-        return HALF_PI_HI
-    if x == -INF:
-        return -HALF_PI_LO
-    r = libm_up(math.atan(x))
-    if x < 0.0:
-        return min(r, 0.0)
-    return min(min(r, x), HALF_PI_HI)
 
 
 @_jit
@@ -497,7 +329,7 @@ def _pow_dn(x, y):
     if y == 1.0:
         return x
     if y == 2.0:
-        return mul_dn(x, x)
+        return max(mul_dn(x, x), 0.0)  # x*x underflowing to 0 steps below 0
     if y == 0.5:
         return sqrt_dn(x)
     if y == -1.0:
@@ -560,165 +392,454 @@ def _join(al, ah, bl, bh):
 
 
 # =============================================================================================
-# forward kernels
+# forward functions: NumPy evaluates f at the bounds, compiled loops widen and clamp
 # =============================================================================================
+# The public function computes ``fl = f(xl)``, ``fh = f(xh)`` with NumPy's ufunc on the whole
+# bound arrays (SIMD code, SVML on AVX-512: within LIBM_ULPS like any libm, shared/RIGOR.md), on
+# the raw bounds: values outside the domain (NaN, +-inf) are never used, the bounds functions
+# select the exact result there. ``_<f>_b(xl, xh, fl, fh) -> (lo, hi)`` then widens the two values
+# and applies the exact facts of the module docstring; the compiled propagation engine calls them
+# directly, with glibc's values (``math.exp(xl)``, ...). The loops ``_<f>_loop`` write ``lo`` into
+# ``fl`` and ``hi`` into ``fh`` in place and run as SIMD code, because the bounds functions are
+# branch-free: plain selects ``a if c else b``, no and/or chains, no builtin min/max. Each
+# comparison costs a mask instruction (one per cycle on x86), so special values are obtained from
+# the clamps where that gives the same result, e.g. ``exp(0) = 1`` from ``exp(x) >= 1 + x`` and
+# ``exp(x) <= 1`` for ``x <= 0``: a libm value within LIBM_ULPS of 1 widens to an interval that
+# straddles 1, and the clamps cut it to exactly 1.
 
-@gufunc(2)
-def _exp(xl, xh, lo, hi):
-    if xl != xl or xh != xh:
-        lo[0] = NAN
-        hi[0] = NAN
-        return
-    lo[0] = _exp_dn(xl)
-    hi[0] = _exp_up(xh)
-
-
-@gufunc(2)
-def _exp2(xl, xh, lo, hi):
-    if xl != xl or xh != xh:
-        lo[0] = NAN
-        hi[0] = NAN
-        return
-    lo[0] = _exp2_dn(xl)
-    hi[0] = _exp2_up(xh)
+@_jit
+def _min(a, b):
+    return a if a < b else b  # vminpd: b when either is NaN
 
 
-@gufunc(2)
-def _exp10(xl, xh, lo, hi):
-    if xl != xl or xh != xh:
-        lo[0] = NAN
-        hi[0] = NAN
-        return
-    lo[0] = _exp10_dn(xl)
-    hi[0] = _exp10_up(xh)
+@_jit
+def _max(a, b):
+    return a if a > b else b
 
 
-@gufunc(2)
-def _expm1(xl, xh, lo, hi):
-    if xl != xl or xh != xh:
-        lo[0] = NAN
-        hi[0] = NAN
-        return
-    lo[0] = _expm1_dn(xl)
-    hi[0] = _expm1_up(xh)
+@_jit
+def _wdn(r):
+    """``libm_dn(r)`` without a comparison: ``r = +inf`` (overflow) gives ``MAX`` through the
+    NaN of ``inf - inf``. ``r = NaN`` gives ``MAX`` too: libm returns NaN only for arguments
+    outside the domain (or empty ones), for which the callers select the result."""
+    return _min(r - (abs(r) * _LIBM_REL + _LIBM_ABS), MAX)
 
 
-@gufunc(2)
-def _log(xl, xh, lo, hi):
-    if not xh > 0.0 or xl != xl:  # empty, or no positive part
-        lo[0] = NAN
-        hi[0] = NAN
-        return
-    lo[0] = -INF if xl <= 0.0 else _log_dn(xl)
-    hi[0] = _log_up(xh)
+@_jit
+def _wup(r):
+    """``libm_up(r)`` without a comparison: ``-inf`` gives ``-MAX``, NaN gives ``-MAX``."""
+    return _max(r + (abs(r) * _LIBM_REL + _LIBM_ABS), -MAX)
 
 
-@gufunc(2)
-def _log2(xl, xh, lo, hi):
-    if not xh > 0.0 or xl != xl:
-        lo[0] = NAN
-        hi[0] = NAN
-        return
-    lo[0] = -INF if xl <= 0.0 else _log2_dn(xl)
-    hi[0] = _log2_up(xh)
+@_jit
+def _add1_dn(x):
+    """A float <= 1 + x, the largest one (rarely the one below): ``add_dn(1, x)`` for
+    ``x < +inf``, with one comparison less."""
+    s = 1.0 + x
+    bb = s - 1.0
+    e = (1.0 - (s - bb)) + (x - bb)  # TwoSum: 1 + x - s exactly (NaN when x = -inf)
+    return s if e >= 0.0 else s - (abs(s) * PHI + ETA)
 
 
-@gufunc(2)
-def _log10(xl, xh, lo, hi):
-    if not xh > 0.0 or xl != xl:
-        lo[0] = NAN
-        hi[0] = NAN
-        return
-    lo[0] = -INF if xl <= 0.0 else _log10_dn(xl)
-    hi[0] = _log10_up(xh)
+@_jit
+def _sub1_up(x):
+    """A float >= x - 1, the smallest one (rarely the one above): ``sub_up(x, 1)`` for
+    ``x > -inf``."""
+    s = x - 1.0
+    bb = s - x
+    e = (x - (s - bb)) + (-1.0 - bb)
+    return s if e <= 0.0 else s + (abs(s) * PHI + ETA)
 
 
-@gufunc(2)
-def _log1p(xl, xh, lo, hi):
-    if not xh > -1.0 or xl != xl:
-        lo[0] = NAN
-        hi[0] = NAN
-        return
-    lo[0] = -INF if xl <= -1.0 else _log1p_dn(xl)
-    hi[0] = _log1p_up(xh)
+@_jit
+def _nan_if_empty(xl, xh, lo, hi):
+    """``(lo, hi)``, or ``(nan, nan)`` when either bound of the argument is NaN (empty)."""
+    lo = NAN if xh != xh else lo
+    hi = NAN if xl != xl else hi
+    lo = NAN if xl != xl else lo
+    return lo, (NAN if xh != xh else hi)
 
 
-@gufunc(2)
-def _sinh(xl, xh, lo, hi):
-    if xl != xl or xh != xh:
-        lo[0] = NAN
-        hi[0] = NAN
-        return
-    lo[0] = _sinh_dn(xl)
-    hi[0] = _sinh_up(xh)
+@intrinsic
+def _f2i(typingctx, x):  # noqa: ARG001 - numba intrinsic signature
+    """The bits of a float64 as an int64."""
+    def codegen(context, builder, signature, args):  # noqa: ARG001
+        return builder.bitcast(args[0], ir.IntType(64))
+    return types.int64(types.float64), codegen
 
 
-@gufunc(2)
-def _cosh(xl, xh, lo, hi):
-    if xl != xl or xh != xh:
-        lo[0] = NAN
-        hi[0] = NAN
-        return
-    if xl >= 0.0:
-        lo[0] = _cosh_dn(xl)
-        hi[0] = _cosh_up(xh)
-    elif xh <= 0.0:
-        lo[0] = _cosh_dn(-xh)
-        hi[0] = _cosh_up(-xl)
-    else:
-        lo[0] = 1.0
-        hi[0] = _cosh_up(max(-xl, xh))
+@intrinsic
+def _i2f(typingctx, i):  # noqa: ARG001
+    """The float64 with the given bits."""
+    def codegen(context, builder, signature, args):  # noqa: ARG001
+        return builder.bitcast(args[0], ir.DoubleType())
+    return types.float64(types.int64), codegen
 
 
-@gufunc(2)
-def _tanh(xl, xh, lo, hi):
-    if xl != xl or xh != xh:
-        lo[0] = NAN
-        hi[0] = NAN
-        return
-    lo[0] = _tanh_dn(xl)
-    hi[0] = _tanh_up(xh)
+@_jit
+def _pow2_int(k):
+    """``2.0**k`` exactly for an integer ``k`` in [-1074, 1023] (subnormals included): the
+    product of two normal powers of two ``2**(k >> 1)`` and ``2**(k - (k >> 1))``."""
+    h = k >> 1
+    return _i2f((h + 1023) << 52) * _i2f((k - h + 1023) << 52)
 
 
-@gufunc(2)
-def _atan(xl, xh, lo, hi):
-    if xl != xl or xh != xh:
-        lo[0] = NAN
-        hi[0] = NAN
-        return
-    lo[0] = _atan_dn(xl)
-    hi[0] = _atan_up(xh)
+@_jit
+def _pow10_int(k):
+    """``10.0**k`` (exact) for an integer ``k`` in [0, 22]."""
+    return _POW10[k]
 
 
-@gufunc(2)
-def _asinh(xl, xh, lo, hi):
-    if xl != xl or xh != xh:
-        lo[0] = NAN
-        hi[0] = NAN
-        return
-    lo[0] = _asinh_dn(xl)
-    hi[0] = _asinh_up(xh)
+@_jit
+def _exp2_exact(x, r):
+    """``2**x`` when ``x`` is an integer in [-1074, 1023] (the power is a float), else ``r``."""
+    k = np.floor(_min(_max(x, -1074.0), 1023.0))  # NaN -> -1074: int() is safe
+    return _pow2_int(int(k)) if x == k else r
 
 
-@gufunc(2)
-def _acosh(xl, xh, lo, hi):
-    if not xh >= 1.0 or xl != xl:  # empty, or nothing in the domain [1, inf]
-        lo[0] = NAN
-        hi[0] = NAN
-        return
-    lo[0] = 0.0 if xl <= 1.0 else _acosh_dn(xl)
-    hi[0] = _acosh_up(xh)
+@_jit
+def _exp10_exact(x, r):
+    """``10**x`` when ``x`` is an integer in [0, 22] (the power is a float), else ``r``."""
+    k = np.floor(_min(_max(x, 0.0), 22.0))
+    return _pow10_int(int(k)) if x == k else r
 
 
-@gufunc(2)
-def _atanh(xl, xh, lo, hi):
-    if xl != xl or xh != xh or xh <= -1.0 or xl >= 1.0:  # nothing in the domain ]-1, 1[
-        lo[0] = NAN
-        hi[0] = NAN
-        return
-    lo[0] = -INF if xl <= -1.0 else _atanh_dn(xl)
-    hi[0] = INF if xh >= 1.0 else _atanh_up(xh)
+@_jit
+def _log2_exact(x, f, r):
+    """``log2(x)`` when ``x > 0`` is a power of two (subnormals too), else ``r``; ``f`` is a
+    libm value of ``log2(x)`` (within a few ulps: it rounds to the exponent)."""
+    k = _min(_max(np.floor(f + 0.5), -1074.0), 1023.0)  # NaN -> -1074
+    return k if _pow2_int(int(k)) == x else r
 
+
+@_jit
+def _log10_exact(x, f, r):
+    """``log10(x)`` when ``x = 10**k``, ``k`` in [0, 22], else ``r``; ``f`` is a libm value of
+    ``log10(x)``."""
+    k = _min(_max(np.floor(f + 0.5), 0.0), 22.0)
+    return k if _pow10_int(int(k)) == x else r
+
+
+@_jit
+def _exp_b(xl, xh, fl, fh):
+    lo = _max(_max(_wdn(fl), _add1_dn(xl)), 0.0)  # exp(x) >= 1 + x (exp(0) = 1)
+    hi = _wup(fh)
+    hi = _min(hi, 1.0) if xh <= 0.0 else hi
+    return _nan_if_empty(xl, xh, lo, hi)
+
+
+@_jit
+def _exp2_b(xl, xh, fl, fh):
+    lo = _exp2_exact(xl, _max(_wdn(fl), 1.0 if xl > 0.0 else 0.0))
+    hi = _wup(fh)
+    hi = _exp2_exact(xh, _min(hi, 1.0) if xh < 0.0 else hi)
+    return _nan_if_empty(xl, xh, lo, hi)
+
+
+@_jit
+def _exp10_b(xl, xh, fl, fh):
+    lo = _exp10_exact(xl, _max(_wdn(fl), 1.0 if xl > 0.0 else 0.0))
+    hi = _wup(fh)
+    hi = _exp10_exact(xh, _min(hi, 1.0) if xh <= 0.0 else hi)
+    return _nan_if_empty(xl, xh, lo, hi)
+
+
+@_jit
+def _expm1_b(xl, xh, fl, fh):
+    lo = _max(_max(_wdn(fl), xl), -1.0)  # expm1(x) >= x (expm1(0) = 0)
+    hi = _wup(fh)
+    hi = _min(hi, 0.0) if xh <= 0.0 else hi
+    return _nan_if_empty(xl, xh, lo, hi)
+
+
+@_jit
+def _log_b(xl, xh, fl, fh):
+    lo = _wdn(fl)
+    lo = _max(lo, 0.0) if xl >= 1.0 else lo  # (log(1) = 0)
+    lo = -INF if xl <= 0.0 else lo
+    hi = _min(_wup(fh), _sub1_up(xh))  # log(x) <= x - 1 (also gives log(1) = 0, log < 0 below)
+    lo = lo if xh > 0.0 else NAN  # no positive part (or empty)
+    return _nan_if_empty(xl, xh, lo, hi if xh > 0.0 else NAN)
+
+
+@_jit
+def _log2_b(xl, xh, fl, fh):
+    lo = _wdn(fl)
+    lo = _log2_exact(xl, fl, _max(lo, 0.0) if xl > 1.0 else lo)
+    lo = -INF if xl <= 0.0 else lo
+    hi = _wup(fh)
+    hi = _log2_exact(xh, fh, _min(hi, 0.0) if xh < 1.0 else hi)
+    lo = lo if xh > 0.0 else NAN
+    return _nan_if_empty(xl, xh, lo, hi if xh > 0.0 else NAN)
+
+
+@_jit
+def _log10_b(xl, xh, fl, fh):
+    lo = _wdn(fl)
+    lo = _log10_exact(xl, fl, _max(lo, 0.0) if xl > 1.0 else lo)
+    lo = -INF if xl <= 0.0 else lo
+    hi = _wup(fh)
+    hi = _log10_exact(xh, fh, _min(hi, 0.0) if xh < 1.0 else hi)
+    lo = lo if xh > 0.0 else NAN
+    return _nan_if_empty(xl, xh, lo, hi if xh > 0.0 else NAN)
+
+
+@_jit
+def _log1p_b(xl, xh, fl, fh):
+    lo = _wdn(fl)
+    lo = _max(lo, 0.0) if xl >= 0.0 else lo  # (log1p(0) = 0)
+    lo = -INF if xl <= -1.0 else lo
+    hi = _min(_wup(fh), xh)  # log1p(x) <= x
+    lo = lo if xh > -1.0 else NAN  # nothing above -1 (or empty)
+    return _nan_if_empty(xl, xh, lo, hi if xh > -1.0 else NAN)
+
+
+@_jit
+def _sinh_b(xl, xh, fl, fh):
+    lo = _wdn(fl)
+    lo = _max(lo, xl) if xl >= 0.0 else lo  # sinh(x) >= x for x >= 0
+    hi = _wup(fh)
+    hi = _min(hi, xh) if xh <= 0.0 else hi
+    return _nan_if_empty(xl, xh, lo, hi)
+
+
+@_jit
+def _cosh_b(xl, xh, fl, fh):
+    # minimum at the end nearest 0 (1 when 0 is inside), maximum at the farthest end; cosh is
+    # even, so the value at xh stands for the one at -xh
+    lo = _max(_wdn(fl if xl >= 0.0 else fh), 1.0)
+    lo = (1.0 if xh > 0.0 else lo) if xl < 0.0 else lo
+    left = -xl >= xh
+    hi = _wup(fl if left else fh)
+    hi = 1.0 if (xl if left else xh) == 0.0 else hi
+    return _nan_if_empty(xl, xh, lo, hi)
+
+
+@_jit
+def _tanh_b(xl, xh, fl, fh):
+    # tanh(x) >= min(x, 0), tanh(x) <= max(x, 0) and |tanh(x)| <= 1 (as min/max: no select)
+    lo = _max(_max(_wdn(fl), _min(xl, 0.0)), -1.0)
+    lo = _ONE_MINUS if xl >= 20.0 else lo  # 1 - tanh(20) = 2 / (e**40 + 1) < 2**-53
+    hi = _min(_min(_wup(fh), _max(xh, 0.0)), 1.0)
+    hi = -_ONE_MINUS if xh <= -20.0 else hi
+    return _nan_if_empty(xl, xh, lo, hi)
+
+
+@_jit
+def _atan_b(xl, xh, fl, fh):
+    # atan(x) >= min(x, 0), atan(x) <= max(x, 0) (atan(0) = 0); the clamps to +-HALF_PI_HI
+    # give atan(-inf) and atan(+inf) from libm values within a few ulps of -+pi/2
+    lo = _max(_max(_wdn(fl), _min(xl, 0.0)), -HALF_PI_HI)
+    hi = _min(_min(_wup(fh), _max(xh, 0.0)), HALF_PI_HI)
+    return _nan_if_empty(xl, xh, lo, hi)
+
+
+@_jit
+def _asinh_b(xl, xh, fl, fh):
+    lo = _max(_wdn(fl), _min(xl, 0.0))  # asinh(x) >= min(x, 0) (asinh(0) = 0)
+    hi = _min(_wup(fh), _max(xh, 0.0))
+    return _nan_if_empty(xl, xh, lo, hi)
+
+
+@_jit
+def _acosh_b(xl, xh, fl, fh):
+    lo = _max(_wdn(fl), 0.0)
+    lo = 0.0 if xl <= 1.0 else lo
+    hi = _wup(fh)
+    hi = 0.0 if xh == 1.0 else hi
+    lo = lo if xh >= 1.0 else NAN  # nothing in the domain [1, inf] (or empty)
+    return _nan_if_empty(xl, xh, lo, hi if xh >= 1.0 else NAN)
+
+
+@_jit
+def _atanh_b(xl, xh, fl, fh):
+    lo = _wdn(fl)
+    lo = _max(lo, xl) if xl >= 0.0 else lo  # atanh(x) >= x for x >= 0
+    lo = -INF if xl <= -1.0 else lo
+    hi = _wup(fh)
+    hi = _min(hi, xh) if xh <= 0.0 else hi
+    hi = INF if xh >= 1.0 else hi
+    # nothing in the domain ]-1, 1[
+    lo = (lo if xl < 1.0 else NAN) if xh > -1.0 else NAN
+    hi = (hi if xl < 1.0 else NAN) if xh > -1.0 else NAN
+    return _nan_if_empty(xl, xh, lo, hi)
+
+
+# One loop per function (a loop taking the bounds function as an argument would not be cached).
+@_fn
+def _exp_loop(xl, xh, fl, fh):
+    for i in range(xl.size):
+        fl[i], fh[i] = _exp_b(xl[i], xh[i], fl[i], fh[i])
+
+
+@_fn
+def _exp2_loop(xl, xh, fl, fh):
+    for i in range(xl.size):
+        fl[i], fh[i] = _exp2_b(xl[i], xh[i], fl[i], fh[i])
+
+
+@_fn
+def _exp10_loop(xl, xh, fl, fh):
+    for i in range(xl.size):
+        fl[i], fh[i] = _exp10_b(xl[i], xh[i], fl[i], fh[i])
+
+
+@_fn
+def _expm1_loop(xl, xh, fl, fh):
+    for i in range(xl.size):
+        fl[i], fh[i] = _expm1_b(xl[i], xh[i], fl[i], fh[i])
+
+
+@_fn
+def _log_loop(xl, xh, fl, fh):
+    for i in range(xl.size):
+        fl[i], fh[i] = _log_b(xl[i], xh[i], fl[i], fh[i])
+
+
+@_fn
+def _log2_loop(xl, xh, fl, fh):
+    for i in range(xl.size):
+        fl[i], fh[i] = _log2_b(xl[i], xh[i], fl[i], fh[i])
+
+
+@_fn
+def _log10_loop(xl, xh, fl, fh):
+    for i in range(xl.size):
+        fl[i], fh[i] = _log10_b(xl[i], xh[i], fl[i], fh[i])
+
+
+@_fn
+def _log1p_loop(xl, xh, fl, fh):
+    for i in range(xl.size):
+        fl[i], fh[i] = _log1p_b(xl[i], xh[i], fl[i], fh[i])
+
+
+@_fn
+def _sinh_loop(xl, xh, fl, fh):
+    for i in range(xl.size):
+        fl[i], fh[i] = _sinh_b(xl[i], xh[i], fl[i], fh[i])
+
+
+@_fn
+def _cosh_loop(xl, xh, fl, fh):
+    for i in range(xl.size):
+        fl[i], fh[i] = _cosh_b(xl[i], xh[i], fl[i], fh[i])
+
+
+@_fn
+def _tanh_loop(xl, xh, fl, fh):
+    for i in range(xl.size):
+        fl[i], fh[i] = _tanh_b(xl[i], xh[i], fl[i], fh[i])
+
+
+@_fn
+def _atan_loop(xl, xh, fl, fh):
+    for i in range(xl.size):
+        fl[i], fh[i] = _atan_b(xl[i], xh[i], fl[i], fh[i])
+
+
+@_fn
+def _asinh_loop(xl, xh, fl, fh):
+    for i in range(xl.size):
+        fl[i], fh[i] = _asinh_b(xl[i], xh[i], fl[i], fh[i])
+
+
+@_fn
+def _acosh_loop(xl, xh, fl, fh):
+    for i in range(xl.size):
+        fl[i], fh[i] = _acosh_b(xl[i], xh[i], fl[i], fh[i])
+
+
+@_fn
+def _atanh_loop(xl, xh, fl, fh):
+    for i in range(xl.size):
+        fl[i], fh[i] = _atanh_b(xl[i], xh[i], fl[i], fh[i])
+
+
+def _np_exp10(a: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+    """``10**a`` by ``np.power`` with an array base: its SIMD loop (a scalar base is not)."""
+    base = np.empty_like(a) if out is None else out
+    base.fill(10.0)
+    return np.power(base, a, out=base)
+
+
+#: Below this size ``out=`` results are copied (cheaper than the overlap checks of the direct path).
+_DIRECT_MIN = 4096
+
+
+def _writable_apart(out: Interval, shape: tuple, xl: np.ndarray, xh: np.ndarray) -> bool:
+    """Whether the bounds of ``out`` are C-contiguous arrays of ``shape`` that overlap neither
+    each other nor the argument bounds (so NumPy may write into them before the loop runs)."""
+    ol, oh = out.lo, out.hi
+    return (ol.shape == shape and oh.shape == shape and ol.flags.c_contiguous
+            and oh.flags.c_contiguous and not np.may_share_memory(ol, oh)
+            and not any(np.may_share_memory(o, a) for o in (ol, oh) for a in (xl, xh)))
+
+
+class _Forward:
+    """A forward interval function: NumPy ufunc(s) at the bounds, then a compiled loop.
+
+    ``bounds`` is the scalar bounds function (for compiled callers), ``loop`` its in-place
+    loop over the flat bound arrays, ``npfs`` the NumPy functions whose values at the two bounds
+    the loop receives (in that order: ``f(xl), f(xh), g(xl), g(xh)``).
+    """
+
+    __slots__ = ("bounds", "loop", "npfs")
+
+    def __init__(self, bounds, loop, *npfs) -> None:
+        self.bounds = bounds
+        self.loop = loop
+        self.npfs = npfs
+
+    def __call__(self, x: IntervalLike, out: Interval | None = None) -> Interval:
+        x = as_interval(x)
+        xl, xh = x.lo, x.hi
+        shape = xl.shape
+        if xh.shape != shape:
+            xl, xh = np.broadcast_arrays(xl, xh)
+            shape = xl.shape
+        a, b = xl.ravel(), xh.ravel()  # contiguous: views, or copies
+        f = self.npfs[0]
+        direct = out is not None and a.size >= _DIRECT_MIN and _writable_apart(out, shape, xl, xh)
+        check_rounding_mode()
+        with np.errstate(all="ignore"):
+            if direct:
+                lo, hi = f(a, out=out.lo.reshape(-1)), f(b, out=out.hi.reshape(-1))
+            else:
+                lo, hi = f(a), f(b)
+            if len(self.npfs) == 1:
+                self.loop(a, b, lo, hi)
+            else:
+                g = self.npfs[1]
+                self.loop(a, b, lo, hi, g(a), g(b))
+        if out is None:
+            return Interval._new(lo.reshape(shape), hi.reshape(shape))
+        if not direct:
+            out.lo[...] = lo.reshape(shape)
+            out.hi[...] = hi.reshape(shape)
+        return out
+
+
+_exp = _Forward(_exp_b, _exp_loop, np.exp)
+_exp2 = _Forward(_exp2_b, _exp2_loop, np.exp2)
+_exp10 = _Forward(_exp10_b, _exp10_loop, _np_exp10)
+_expm1 = _Forward(_expm1_b, _expm1_loop, np.expm1)
+_log = _Forward(_log_b, _log_loop, np.log)
+_log2 = _Forward(_log2_b, _log2_loop, np.log2)
+_log10 = _Forward(_log10_b, _log10_loop, np.log10)
+_log1p = _Forward(_log1p_b, _log1p_loop, np.log1p)
+_sinh = _Forward(_sinh_b, _sinh_loop, np.sinh)
+_cosh = _Forward(_cosh_b, _cosh_loop, np.cosh)
+_tanh = _Forward(_tanh_b, _tanh_loop, np.tanh)
+_atan = _Forward(_atan_b, _atan_loop, np.arctan)
+_asinh = _Forward(_asinh_b, _asinh_loop, np.arcsinh)
+_acosh = _Forward(_acosh_b, _acosh_loop, np.arccosh)
+_atanh = _Forward(_atanh_b, _atanh_loop, np.arctanh)
+
+
+# =============================================================================================
+# forward kernels: atan2, pow
+# =============================================================================================
 
 @_jit
 def _atan2_upper_half(yl, yh, xl, xh):
@@ -1114,14 +1235,6 @@ def _pow_rev(zl, zh, xl, xh, yl, yh, xlo, xhi, ylo, yhi):
 # public functions
 # =============================================================================================
 
-def _unary(kernel, x: IntervalLike, out: Interval | None) -> Interval:
-    x = as_interval(x)
-    if out is None:
-        return Interval._new(*kernel(x.lo, x.hi))
-    kernel(x.lo, x.hi, out.lo, out.hi)
-    return out
-
-
 def _binary(kernel, x: IntervalLike, y: IntervalLike, out: Interval | None) -> Interval:
     x, y = as_interval(x), as_interval(y)
     if out is None:
@@ -1132,79 +1245,79 @@ def _binary(kernel, x: IntervalLike, y: IntervalLike, out: Interval | None) -> I
 
 def exp(x: IntervalLike, out: Interval | None = None) -> Interval:
     """``exp(x)``; ``exp(-inf) = 0``, overflow gives ``[MAX, inf]``."""
-    return _unary(_exp, x, out)
+    return _exp(x, out)
 
 
 def exp2(x: IntervalLike, out: Interval | None = None) -> Interval:
     """``2**x`` (exact for integer ``x`` in [-1074, 1023])."""
-    return _unary(_exp2, x, out)
+    return _exp2(x, out)
 
 
 def exp10(x: IntervalLike, out: Interval | None = None) -> Interval:
     """``10**x`` (exact for integer ``x`` in [0, 22])."""
-    return _unary(_exp10, x, out)
+    return _exp10(x, out)
 
 
 def expm1(x: IntervalLike, out: Interval | None = None) -> Interval:
     """``exp(x) - 1``, accurate near 0."""
-    return _unary(_expm1, x, out)
+    return _expm1(x, out)
 
 
 def log(x: IntervalLike, out: Interval | None = None) -> Interval:
     """Natural logarithm of the part of ``x`` above 0 (``log([0, 1]) = [-inf, 0]``; empty when
     ``x <= 0``)."""
-    return _unary(_log, x, out)
+    return _log(x, out)
 
 
 def log2(x: IntervalLike, out: Interval | None = None) -> Interval:
     """Base-2 logarithm of the part of ``x`` above 0 (exact at powers of two)."""
-    return _unary(_log2, x, out)
+    return _log2(x, out)
 
 
 def log10(x: IntervalLike, out: Interval | None = None) -> Interval:
     """Base-10 logarithm of the part of ``x`` above 0 (exact at 10**k, k = 0..22)."""
-    return _unary(_log10, x, out)
+    return _log10(x, out)
 
 
 def log1p(x: IntervalLike, out: Interval | None = None) -> Interval:
     """``log(1 + x)`` over the part of ``x`` above -1, accurate near 0."""
-    return _unary(_log1p, x, out)
+    return _log1p(x, out)
 
 
 def sinh(x: IntervalLike, out: Interval | None = None) -> Interval:
     """Hyperbolic sine."""
-    return _unary(_sinh, x, out)
+    return _sinh(x, out)
 
 
 def cosh(x: IntervalLike, out: Interval | None = None) -> Interval:
     """Hyperbolic cosine (``cosh([-1, 2]) = [1, cosh 2]``)."""
-    return _unary(_cosh, x, out)
+    return _cosh(x, out)
 
 
 def tanh(x: IntervalLike, out: Interval | None = None) -> Interval:
     """Hyperbolic tangent, within [-1, 1]."""
-    return _unary(_tanh, x, out)
+    return _tanh(x, out)
 
 
 def atan(x: IntervalLike, out: Interval | None = None) -> Interval:
     """Arc tangent, within ``[-HALF_PI_HI, HALF_PI_HI]``."""
-    return _unary(_atan, x, out)
+    return _atan(x, out)
 
 
 def asinh(x: IntervalLike, out: Interval | None = None) -> Interval:
     """Inverse hyperbolic sine."""
-    return _unary(_asinh, x, out)
+    return _asinh(x, out)
 
 
 def acosh(x: IntervalLike, out: Interval | None = None) -> Interval:
     """Inverse hyperbolic cosine of the part of ``x`` in [1, inf] (empty when ``x < 1``)."""
-    return _unary(_acosh, x, out)
+    return _acosh(x, out)
 
 
 def atanh(x: IntervalLike, out: Interval | None = None) -> Interval:
     """Inverse hyperbolic tangent of the part of ``x`` in ]-1, 1[ (``atanh([-1, 1])`` is the
     entire line, ``atanh([1, 2])`` is empty)."""
-    return _unary(_atanh, x, out)
+    return _atanh(x, out)
 
 
 def atan2(y: IntervalLike, x: IntervalLike, out: Interval | None = None) -> Interval:

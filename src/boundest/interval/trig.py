@@ -1,6 +1,8 @@
 """Trigonometric functions ``sin cos tan asin acos`` and their reverse (backward) operators.
 
-Every kernel is a Numba gufunc over the bound arrays; libm values are widened by ``LIBM_ULPS``
+Every kernel is a Numba gufunc over the bound arrays, except asin and acos, whose libm values
+at the bounds come from NumPy's ufuncs on the whole arrays (SIMD code) before a compiled
+branch-free loop (see explog's forward functions); libm values are widened by ``LIBM_ULPS``
 (``libm_dn``/``libm_up``) and clamped to the function's range. Soundness rests on these facts:
 
 * ``PI_LO < pi < PI_HI`` (consecutive floats), so ``n * PIO2_LO`` and ``n * PIO2_HI`` rounded
@@ -28,9 +30,11 @@ from __future__ import annotations
 import math
 
 import numba as nb
+import numpy as np
 from numpy.typing import ArrayLike
 
 from .core import Interval, as_interval
+from .explog import _Forward, _max, _min, _wdn, _wup
 from .rounding import (
     INF,
     NAN,
@@ -330,24 +334,71 @@ def _tan(a, b, lo, hi):
     hi[0] = _tan_enc(b)[1]
 
 
-@gufunc(2)
-def _asin(a, b, lo, hi):
-    if not (a <= 1.0 and b >= -1.0):  # empty, or disjoint from the domain
-        lo[0] = NAN
-        hi[0] = NAN
-        return
-    lo[0] = _asin_enc(max(a, -1.0))[0]
-    hi[0] = _asin_enc(min(b, 1.0))[1]
+# asin and acos: NumPy evaluates them at the bounds (explog._Forward), the branch-free bounds
+# functions below widen, clamp and apply the refinements of _asin_enc / _acos_enc (asin(0) = 0
+# comes from the clamps: see explog).
+
+@_jit
+def _asin_dn_at(z, g):
+    """Lower bound of asin(z) for z <= 1 (below -1: -pi/2), ``g`` a libm value of asin(z)."""
+    r = _max(_wdn(g), -PIO2_HI)
+    r = _max(r, z) if z >= 0.0 else r  # asin(z) >= z for z >= 0
+    r = _max(r, next_down(z)) if z > -_SMALL else r  # asin(z) > pred(z) for -2**-26 < z < 0
+    r = PIO2_LO if z == 1.0 else r
+    return -PIO2_HI if z <= -1.0 else r
 
 
-@gufunc(2)
-def _acos(a, b, lo, hi):
-    if not (a <= 1.0 and b >= -1.0):
-        lo[0] = NAN
-        hi[0] = NAN
-        return
-    lo[0] = _acos_enc(min(b, 1.0))[0]
-    hi[0] = _acos_enc(max(a, -1.0))[1]
+@_jit
+def _asin_up_at(z, g):
+    """Upper bound of asin(z) for z >= -1 (above 1: pi/2), ``g`` a libm value of asin(z)."""
+    r = _min(_wup(g), PIO2_HI)
+    r = _min(r, z) if z <= 0.0 else r
+    r = _min(r, next_up(z)) if z < _SMALL else r
+    r = -PIO2_LO if z == -1.0 else r
+    return PIO2_HI if z >= 1.0 else r
+
+
+@_jit
+def _asin_b(a, b, fa, fb):
+    """Bounds of asin([a, b]) from ``fa, fb`` = libm asin at a, b (NaN outside [-1, 1])."""
+    lo = _asin_dn_at(a, fa)
+    hi = _asin_up_at(b, fb)
+    lo = (lo if a <= 1.0 else NAN) if b >= -1.0 else NAN  # empty, or disjoint from the domain
+    hi = (hi if a <= 1.0 else NAN) if b >= -1.0 else NAN
+    return lo, hi
+
+
+@_jit
+def _acos_b(a, b, fa, fb, ga, gb):
+    """Bounds of acos([a, b]) from ``fa, fb`` = libm acos and ``ga, gb`` = libm asin at a, b
+    (only used where |z| <= 1/2, where ``acos = pi/2 - asin`` is tighter); acos decreases."""
+    lo = _max(_wdn(fb), 0.0)
+    lo = sub_dn(PIO2_LO, _asin_up_at(b, gb)) if abs(b) <= 0.5 else lo
+    lo = PI_LO if b == -1.0 else lo
+    lo = 0.0 if b >= 1.0 else lo
+    hi = _min(_wup(fa), PI_HI)
+    hi = sub_up(PIO2_HI, _asin_dn_at(a, ga)) if abs(a) <= 0.5 else hi
+    hi = 0.0 if a == 1.0 else hi
+    hi = PI_HI if a <= -1.0 else hi
+    lo = (lo if a <= 1.0 else NAN) if b >= -1.0 else NAN
+    hi = (hi if a <= 1.0 else NAN) if b >= -1.0 else NAN
+    return lo, hi
+
+
+@_njit
+def _asin_loop(xl, xh, fl, fh):
+    for i in range(xl.size):
+        fl[i], fh[i] = _asin_b(xl[i], xh[i], fl[i], fh[i])
+
+
+@_njit
+def _acos_loop(xl, xh, fl, fh, gl, gh):
+    for i in range(xl.size):
+        fl[i], fh[i] = _acos_b(xl[i], xh[i], fl[i], fh[i], gl[i], gh[i])
+
+
+_asin = _Forward(_asin_b, _asin_loop, np.arcsin)
+_acos = _Forward(_acos_b, _acos_loop, np.arccos, np.arcsin)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -631,12 +682,12 @@ def tan(x: IntervalLike, out: Interval | None = None) -> Interval:
 
 def asin(x: IntervalLike, out: Interval | None = None) -> Interval:
     """Arcsine over the part of ``x`` in ``[-1, 1]`` (empty if disjoint)."""
-    return _unary(_asin, x, out)
+    return _asin(x, out)
 
 
 def acos(x: IntervalLike, out: Interval | None = None) -> Interval:
     """Arccosine over the part of ``x`` in ``[-1, 1]`` (empty if disjoint)."""
-    return _unary(_acos, x, out)
+    return _acos(x, out)
 
 
 def sin_rev(z: IntervalLike, x: IntervalLike | None = None,
