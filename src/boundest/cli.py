@@ -69,7 +69,7 @@ def _run_satellite(args: argparse.Namespace) -> int:
 
     meas = sat.load(args.data, k_max=args.kmax)
     print(f"satellite (seed 000): k_max = {meas.k_max}, data {meas.source}")
-    print(f"CSP: {7 * (meas.k_max + 1)} constraints over {11 * (meas.k_max + 1) + 8} variables; "
+    print(f"CSP: {7 * (meas.k_max + 1)} constraints over {11 * meas.k_max + 15} variables; "
           "first run compiles the propagation kernel (cached afterwards)")
     res = sat.solve(meas, rel_eps=args.rel_eps)
     if not res.consistent and args.beta_tuning:
