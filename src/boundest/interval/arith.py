@@ -77,33 +77,20 @@ def _mul_hi(al, ah, bl, bh):
     return NAN if bl != bl else r
 
 
-@_njit
-def _cdn(a, b):
-    """Lower bound of the corner ``a/b``; ``a/inf = 0``; ``inf/inf`` has no limit and gives 0
-    too, which the corner ``a/inf`` of the same quotient always reaches (NaN inputs are
-    handled by the caller)."""
-    r = div_dn(a, b)
-    r = 0.0 if abs(b) == INF else r  # a / inf = 0 exactly (inf / inf: 0 is dominated too)
-    return INF if r != r else r
-
-
-@_njit
-def _cup(a, b):
-    r = div_up(a, b)
-    r = 0.0 if abs(b) == INF else r
-    return -INF if r != r else r
-
-
-# Nested selects rather than and/or chains: short-circuit logic blocks vectorisation.
+# Division: the signs of the bounds select which corner is extreme, so each bound costs one
+# division (selects only, no branches). ``pos``: divisor >= 0 (lower bound at 0 allowed);
+# ``neg``: divisor <= 0 with a negative lower bound; otherwise 0 is strictly inside (or the
+# divisor is [0, 0]). A selected zero denominator means an infinite bound; the corner choices
+# never divide inf by inf.
 @ufunc(4)
 def _div_lo(al, ah, bl, bh):
-    r = _min(_min(_cdn(al, bl), _cdn(al, bh)), _min(_cdn(ah, bl), _cdn(ah, bh)))
-    # 0 in the divisor: a half-line when a dividend bound and a divisor bound are at 0
-    s = -INF
-    s = (div_dn(al, bh) if al >= 0.0 else s) if bl == 0.0 else s
-    s = (div_dn(ah, bl) if ah <= 0.0 else s) if bh == 0.0 else s
-    s = (0.0 if ah == 0.0 else s) if al == 0.0 else s
-    r = (s if bh >= 0.0 else r) if bl <= 0.0 else r
+    pos = bl >= 0.0
+    n = al if pos else ah
+    d = (bh if al >= 0.0 else bl) if pos else (bh if ah > 0.0 else bl)
+    r = div_dn(n, d)
+    r = -INF if d == 0.0 else r
+    r = r if (pos or bh <= 0.0) else -INF  # 0 strictly inside the divisor
+    r = (0.0 if ah == 0.0 else r) if al == 0.0 else r  # [0, 0] / y = [0, 0]
     r = (NAN if bh == 0.0 else r) if bl == 0.0 else r  # divisor [0, 0]: empty
     r = NAN if al != al else r
     return NAN if bl != bl else r
@@ -111,12 +98,13 @@ def _div_lo(al, ah, bl, bh):
 
 @ufunc(4)
 def _div_hi(al, ah, bl, bh):
-    r = _max(_max(_cup(al, bl), _cup(al, bh)), _max(_cup(ah, bl), _cup(ah, bh)))
-    s = INF
-    s = (div_up(ah, bh) if ah <= 0.0 else s) if bl == 0.0 else s
-    s = (div_up(al, bl) if al >= 0.0 else s) if bh == 0.0 else s
-    s = (0.0 if ah == 0.0 else s) if al == 0.0 else s
-    r = (s if bh >= 0.0 else r) if bl <= 0.0 else r
+    pos = bl >= 0.0
+    n = ah if pos else al
+    d = (bl if ah > 0.0 else bh) if pos else (bl if al >= 0.0 else bh)
+    r = div_up(n, d)
+    r = INF if d == 0.0 else r
+    r = r if (pos or bh <= 0.0) else INF
+    r = (0.0 if ah == 0.0 else r) if al == 0.0 else r
     r = (NAN if bh == 0.0 else r) if bl == 0.0 else r
     r = NAN if al != al else r
     return NAN if bl != bl else r
