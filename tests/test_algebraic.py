@@ -23,6 +23,7 @@ from hypothesis import strategies as st
 from boundest import Interval
 from boundest.interval import algebraic as alg
 
+from .checks import is_empty, same, subset, valid
 from .strategies import intervals, point_in, ulps_apart
 
 mpmath.mp.prec = 256
@@ -57,24 +58,12 @@ def point_in_result(a: float, x: Interval) -> bool:
     return lo <= a <= hi  # False for an empty result
 
 
-def valid(z: Interval) -> bool:
-    """Representation invariants: both bounds NaN, or lo <= hi, lo != +inf, hi != -inf."""
-    lo, hi = np.asarray(z.lo), np.asarray(z.hi)
-    empty = np.isnan(lo) & np.isnan(hi)
-    ok = (lo <= hi) & (lo < INF) & (hi > -INF)
-    return bool(np.all(empty | ok))
 
 
-def is_empty(z: Interval) -> bool:
-    return bool(np.all(z.is_empty()))
 
 
-def subset(a: Interval, b: Interval) -> bool:
-    return bool(np.all(a.is_subset(b)))
 
 
-def same(z: Interval, lo: float, hi: float) -> bool:
-    return float(z.lo) == lo and float(z.hi) == hi
 
 
 def f_dn(q: Fraction) -> float:

@@ -1,0 +1,45 @@
+"""Assertion helpers shared by the interval tests (plain functions returning bools)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from boundest import Interval
+
+INF = math.inf
+
+
+def valid(z: Interval) -> bool:
+    """The representation invariants: both bounds NaN, or lo <= hi, lo != +inf, hi != -inf."""
+    lo, hi = np.asarray(z.lo), np.asarray(z.hi)
+    empty = np.isnan(lo) & np.isnan(hi)
+    ok = (lo <= hi) & (lo < INF) & (hi > -INF)
+    return bool(np.all(empty | ok))
+
+
+def is_empty(z: Interval) -> bool:
+    return bool(np.all(z.is_empty()))
+
+
+def subset(a: Interval, b: Interval) -> bool:
+    return bool(np.all(a.is_subset(b)))
+
+
+def same(z: Interval, lo: float, hi: float) -> bool:
+    """``z`` is exactly ``[lo, hi]``."""
+    return float(z.lo) == lo and float(z.hi) == hi
+
+
+def engine_forward(name: str, x: Interval) -> Interval:
+    """Images of the scalar intervals of ``x`` through the compiled engine's forward kernel."""
+    from boundest.csp import engine
+
+    code = getattr(engine, name.upper())
+    buf = np.empty(4)
+    lo, hi = np.empty(x.lo.size), np.empty(x.lo.size)
+    for i in range(x.lo.size):
+        engine._forward(code, float(x.lo.flat[i]), float(x.hi.flat[i]), 0.0, 0.0, 0.0, buf)
+        lo[i], hi[i] = buf[0], buf[1]
+    return Interval._new(lo, hi)
