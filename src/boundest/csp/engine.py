@@ -1,10 +1,10 @@
-"""The compiled propagation kernel: an AC3-style queue over the primitive nodes of a tape.
+"""The compiled propagation kernel: AC3-style revisions of the primitive nodes of a tape.
 
 Each node ``z = f(x, y)`` is revised by ``z ∩= f(x, y)`` then ``(x, y) = f_rev(z, x, y)``. When a
 slot's domain shrinks by more than ``rel_eps`` of its width (or loses an infinite bound), every
-other node using that slot is queued again. The queue is FIFO, initialised in tape order, so the
-first pass over a time-series model is a forward sweep and later passes follow the changes in both
-directions: the work per time step does not grow with the horizon.
+other node using that slot becomes dirty again. Dirty nodes are revised in alternating forward
+and backward sweeps over the tape order (the order of the constraints, i.e. of the time steps
+for a time series), so that the work per time step does not grow with the horizon.
 """
 
 from __future__ import annotations
@@ -223,24 +223,33 @@ def _update(s, nl, nh, lo, hi, rel_eps):
 
 
 @nb.njit(cache=True, error_model="numpy")
-def propagate_kernel(op, out, a, b, param, lo, hi, ptr, adj, queue, inq, state, rel_eps,
-                     max_evals):
-    """Run the queue for at most ``max_evals`` node revisions.
+def propagate_kernel(op, out, a, b, param, lo, hi, ptr, adj, dirty, state, rel_eps, max_evals):
+    """Revise dirty nodes in alternating forward and backward sweeps, for at most ``max_evals``
+    node revisions.
 
-    ``state = [head, count, status, evals_total]`` is read and written so that a long run can be
-    continued in chunks (for progress reports). ``ptr``/``adj`` list, for each slot, the nodes
-    using it (CSR). Returns the status (DONE, RUNNING or EMPTY).
+    A node is dirty when one of its slots shrank significantly since its last revision. Sweeps
+    visit the nodes in tape order, then in reverse order, and so on (Gauss-Seidel): along a time
+    series, one sweep carries information through the whole horizon, where a FIFO queue moves
+    it by one step per wave. ``state = [position, dirty count, status, evals_total,
+    direction]`` is read and written so that a long run can be continued in chunks (progress
+    reports). ``ptr``/``adj`` list, for each slot, the nodes using it (CSR). Returns the status
+    (DONE, RUNNING or EMPTY).
     """
     n = op.size
-    head, count, evals = state[0], state[1], 0
+    pos, count, evals, direction = state[0], state[1], 0, state[4]
     buf = np.empty(4)
     changed = np.empty(3, dtype=np.int64)
     status = RUNNING
     while count > 0 and evals < max_evals:
-        i = queue[head]
-        head = head + 1 if head + 1 < n else 0
+        if pos >= n or pos < 0:  # end of a sweep: turn round
+            direction = -direction
+            pos = 0 if direction > 0 else n - 1
+        i = pos
+        pos += direction
+        if not dirty[i]:
+            continue
+        dirty[i] = False
         count -= 1
-        inq[i] = False
         evals += 1
         code, o, ia, ib = op[i], out[i], a[i], b[i]
         # the node itself is revised again only when it reads what it writes
@@ -279,12 +288,11 @@ def propagate_kernel(op, out, a, b, param, lo, hi, ptr, adj, queue, inq, state, 
             s = changed[c]
             for k in range(ptr[s], ptr[s + 1]):
                 j = adj[k]
-                if (j != i or again) and not inq[j]:
-                    inq[j] = True
-                    tail = head + count
-                    queue[tail if tail < n else tail - n] = j
+                if (j != i or again) and not dirty[j]:
+                    dirty[j] = True
                     count += 1
     if status != EMPTY and count == 0:
         status = DONE
-    state[0], state[1], state[2], state[3] = head, count, status, state[3] + evals
+    state[0], state[1], state[2], state[3], state[4] = pos, count, status, state[3] + evals, \
+        direction
     return status

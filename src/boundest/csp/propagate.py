@@ -102,18 +102,17 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
     budget = 10_000 * max(tape.n_nodes, 1) if max_evaluations is None else max_evaluations
     ptr, adj = slot_users(tape)
     n = tape.n_nodes
-    queue = np.arange(n, dtype=np.int64)
-    inq = np.ones(n, dtype=np.bool_)
-    state = np.array([0, n, RUNNING, 0], dtype=np.int64)
+    dirty = np.ones(n, dtype=np.bool_)
+    state = np.array([0, n, RUNNING, 0, 1], dtype=np.int64)
     # a zero-budget call compiles (first use) or loads the kernel outside the timed part
-    propagate_kernel(tape.op, tape.out, tape.a, tape.b, tape.param, lo, hi, ptr, adj, queue,
-                     inq, state.copy(), rel_eps, 0)
+    propagate_kernel(tape.op, tape.out, tape.a, tape.b, tape.param, lo, hi, ptr, adj, dirty,
+                     state.copy(), rel_eps, 0)
     t0 = time.perf_counter()
     status = EMPTY if np.isnan(lo).any() or (lo > hi).any() else RUNNING
     bar = None
     while status == RUNNING and state[3] < budget and n > 0:
         status = propagate_kernel(tape.op, tape.out, tape.a, tape.b, tape.param, lo, hi, ptr,
-                                  adj, queue, inq, state, rel_eps, min(chunk, budget - state[3]))
+                                  adj, dirty, state, rel_eps, min(chunk, budget - state[3]))
         if bar is None and status == RUNNING and (progress or (
                 progress is None and time.perf_counter() - t0 > 2.0)):
             from tqdm import tqdm
@@ -121,7 +120,7 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
             bar = tqdm(total=budget, unit="rev", desc="propagating", leave=False)
         if bar is not None:
             bar.n = int(state[3])
-            bar.set_postfix(queued=int(state[1]))
+            bar.set_postfix(dirty=int(state[1]))
             bar.refresh()
     if bar is not None:
         bar.close()
