@@ -56,6 +56,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from _machine import cpu_model
 
 # ----------------------------------------------------------------------------------------------
 # input domains: each maps (rng, n) to the bounds (lo, hi) of n random intervals
@@ -731,14 +732,7 @@ def _machine(env: dict) -> dict:
         "loadavg_start": env.get("loadavg_start"),
         "loadavg_end": list(os.getloadavg()) if hasattr(os, "getloadavg") else None,
     }
-    try:
-        with open("/proc/cpuinfo") as fh:
-            for line in fh:
-                if line.startswith("model name"):
-                    info["cpu_model"] = line.split(":", 1)[1].strip()
-                    break
-    except OSError:
-        pass
+    info["cpu_model"] = cpu_model()
     try:
         from numpy._core._multiarray_umath import __cpu_features__ as feats
         info["cpu_simd"] = {k: bool(feats.get(k)) for k in ("AVX2", "FMA3", "AVX512F")}

@@ -46,6 +46,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from _machine import cpu_model
 
 ROOT = Path(__file__).resolve().parent.parent
 CODAC_PY = ROOT / ".bench-venv-codac1" / "bin" / "python"
@@ -246,14 +247,7 @@ def _machine() -> dict:
         "numba_cache_dir": os.environ.get("NUMBA_CACHE_DIR"),
         "loadavg_end": list(os.getloadavg()) if hasattr(os, "getloadavg") else None,
     }
-    try:
-        with open("/proc/cpuinfo") as fh:
-            for line in fh:
-                if line.startswith("model name"):
-                    info["cpu_model"] = line.split(":", 1)[1].strip()
-                    break
-    except OSError:
-        pass
+    info["cpu_model"] = cpu_model()
     return info
 
 

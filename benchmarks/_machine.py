@@ -1,0 +1,15 @@
+"""What the benchmarks record about the machine they ran on."""
+
+from __future__ import annotations
+
+
+def cpu_model() -> str | None:
+    """The CPU model name from /proc/cpuinfo (None where there is no such file)."""
+    try:
+        with open("/proc/cpuinfo") as fh:
+            for line in fh:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return None
