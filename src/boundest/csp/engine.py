@@ -46,7 +46,7 @@ _f_exp, _f_log, _f_sinh, _f_cosh = el._exp.bounds, el._log.bounds, el._sinh.boun
 _f_tanh, _f_atan, _f_asin, _f_acos = (el._tanh.bounds, el._atan.bounds, tr._asin.bounds,
                                       tr._acos.bounds)
 _f_atan2, _f_pow = el._atan2.scalar, el._pow.scalar
-_f_sin, _f_cos, _f_tan = tr._sin.scalar, tr._cos.scalar, tr._tan.scalar
+_f_sin, _f_cos, _f_tan = tr._sin.scalar, tr._cos.scalar, tr._tan.bounds
 _f_abs, _f_sign, _f_floor, _f_ceil = (al._abs.scalar, al._sign.scalar, al._floor.scalar,
                                       al._ceil.scalar)
 _f_pown, _f_min, _f_max = al._pown.scalar, al._min.scalar, al._max.scalar
@@ -102,7 +102,7 @@ def _forward(code, xl, xh, yl, yh, p, buf):
     elif code == COS:
         _f_cos(xl, xh, o0, o1)
     elif code == TAN:
-        _f_tan(xl, xh, o0, o1)
+        buf[0], buf[1] = _f_tan(xl, xh, math.tan(xl), math.tan(xh))
     elif code == ASIN:
         buf[0], buf[1] = _f_asin(xl, xh, math.asin(xl), math.asin(xh))
     elif code == ACOS:  # asin is only used where |x| <= 1/2

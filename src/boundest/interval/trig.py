@@ -133,15 +133,14 @@ def _cos_enc(x):
 
 
 @_jit
-def _tan_enc(x):
-    """Enclosure of tan(x) for finite x (a float is never a pole)."""
+def _tan_enc(x, r):
+    """Enclosure of tan(x) for finite x (a float is never a pole), from a libm value ``r``."""
     if x == 0.0:
         return 0.0, 0.0
     if abs(x) < _SMALL:
         if x > 0.0:
             return x, next_up(x)
         return next_down(x), x
-    r = math.tan(x)
     dn = libm_dn(r)
     up = libm_up(r)
     if 0.0 < x <= PIO2_LO:
@@ -310,28 +309,32 @@ def _cos(a, b, lo, hi):
     lo[0], hi[0] = _sincos(a, b, 1)
 
 
-@gufunc(2)
-def _tan(a, b, lo, hi):
+@_jit
+def _tan_b(a, b, ta, tb):
+    """Bounds of tan([a, b]) from ``ta, tb`` = libm tan at a, b (NumPy's, or glibc's in the
+    engine): the entire line when a pole may lie inside, else monotone."""
     if a != a or b != b:
-        lo[0] = NAN
-        hi[0] = NAN
-        return
+        return NAN, NAN
     if a < -BIG or b > BIG or b - a >= 4.0:  # a width > pi surely holds a pole
-        lo[0] = -INF
-        hi[0] = INF
-        return
+        return -INF, INF
     if a != b:  # poles: n pi/2 with n odd
         n, end = _quadrants(a, b)
         if n & 1 == 0:
             n += 1
         while n <= end:
             if _halfpi_may_be_in(n, a, b):
-                lo[0] = -INF
-                hi[0] = INF
-                return
+                return -INF, INF
             n += 2
-    lo[0] = _tan_enc(a)[0]
-    hi[0] = _tan_enc(b)[1]
+    return _tan_enc(a, ta)[0], _tan_enc(b, tb)[1]
+
+
+@_njit
+def _tan_loop(xl, xh, fl, fh):
+    for i in range(xl.size):
+        fl[i], fh[i] = _tan_b(xl[i], xh[i], fl[i], fh[i])
+
+
+_tan = _Forward(_tan_b, _tan_loop, np.tan)
 
 
 # asin and acos: NumPy evaluates them at the bounds (explog._Forward), the branch-free bounds
@@ -677,7 +680,7 @@ def cos(x: IntervalLike, out: Interval | None = None) -> Interval:
 def tan(x: IntervalLike, out: Interval | None = None) -> Interval:
     """Tangent: the entire line when ``x`` may contain a pole ``pi/2 + k pi`` (or for bounds
     beyond ``2**30``), else ``[tan(lo), tan(hi)]`` rounded outward."""
-    return _unary(_tan, x, out)
+    return _tan(x, out)
 
 
 def asin(x: IntervalLike, out: Interval | None = None) -> Interval:
