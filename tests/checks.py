@@ -3,12 +3,21 @@
 from __future__ import annotations
 
 import math
+from fractions import Fraction
 
 import numpy as np
 
 from boundest import Interval
 
 INF = math.inf
+
+
+def exact_in(q: Fraction | float, x: Interval) -> bool:
+    """Whether the exact real ``q`` (a Fraction or float) lies in the scalar interval ``x``."""
+    lo, hi = float(x.lo), float(x.hi)
+    if math.isnan(lo):
+        return False
+    return (lo == -INF or Fraction(lo) <= q) and (hi == INF or q <= Fraction(hi))
 
 
 def valid(z: Interval) -> bool:

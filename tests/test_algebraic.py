@@ -23,7 +23,7 @@ from hypothesis import strategies as st
 from boundest import Interval
 from boundest.interval import algebraic as alg
 
-from .checks import is_empty, same, subset, valid
+from .checks import exact_in, is_empty, same, subset, valid
 from .strategies import intervals, point_in, ulps_apart
 
 mpmath.mp.prec = 256
@@ -37,14 +37,6 @@ ENTIRE = Interval.entire()
 # -------------------------------------------------------------------------------------------
 # helpers
 # -------------------------------------------------------------------------------------------
-
-def exact_in(q: Fraction, x: Interval) -> bool:
-    """Whether the exact rational ``q`` lies in the scalar float interval ``x``."""
-    lo, hi = float(x.lo), float(x.hi)
-    if math.isnan(lo):
-        return False
-    return (lo == -INF or Fraction(lo) <= q) and (hi == INF or q <= Fraction(hi))
-
 
 def mp_in(v: mpmath.mpf, x: Interval) -> bool:
     lo, hi = float(x.lo), float(x.hi)

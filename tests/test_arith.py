@@ -14,19 +14,12 @@ from hypothesis import strategies as st
 import boundest as bd
 from boundest import Interval
 
+from .checks import exact_in
 from .strategies import intervals, point_in, ulps_apart
 
 mpmath.mp.prec = 256
 EMPTY = Interval.empty()
 ENTIRE = Interval.entire()
-
-
-def exact_in(value: Fraction | float, x: Interval) -> bool:
-    """Whether an exact real value lies in the float interval ``x``."""
-    lo, hi = float(x.lo), float(x.hi)
-    if math.isnan(lo):
-        return False
-    return (lo == -math.inf or Fraction(lo) <= value) and (hi == math.inf or value <= Fraction(hi))
 
 
 OPS = {

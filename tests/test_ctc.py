@@ -34,6 +34,8 @@ from boundest.expr import Const, Model, Op, Var, parse_model
 from boundest.expr.parser import decimal_interval
 from boundest.expr.tape import compile_model
 
+from .strategies import ulps_apart
+
 MAX = 1.7976931348623157e308
 INF = math.inf
 x, y, z, w, u = Var("x"), Var("y"), Var("z"), Var("w"), Var("u")
@@ -394,10 +396,6 @@ def test_shared_subexpressions_and_repeated_variables(a, b, da, db):
 # explicit contractions, derived by hand
 # -------------------------------------------------------------------------------------------
 
-def ulps(a: float, b: float) -> int:
-    return abs(int(np.float64(a).view(np.int64)) - int(np.float64(b).view(np.int64)))
-
-
 def test_linear_pair_by_hand():
     # x + y = 3, x - y = 1 on [0, 10]^2. Forward: x+y = 3, x-y = 1. Backward (last node first):
     # x - y = 1 gives x = 1 + y = [1, 10], y = x - 1 = [0, 9]; x + y = 3 gives x = 3 - y = [1, 3],
@@ -421,11 +419,11 @@ def test_nonlinear_contractions_by_hand():
     r = CtcFwdBwd([x**2 == 2], ["x"])(Interval([-10], [10]))
     lo, hi = float(r.lo[0]), float(r.hi[0])
     assert mpmath.mpf(lo) <= -sqrt2 and sqrt2 <= mpmath.mpf(hi)
-    assert ulps(lo, -float(sqrt2)) <= 2 and ulps(hi, float(sqrt2)) <= 2
+    assert ulps_apart(lo, -float(sqrt2)) <= 2 and ulps_apart(hi, float(sqrt2)) <= 2
     # on [0, 10]: only the positive root
     r = CtcFwdBwd([x**2 == 2], ["x"])(Interval([0], [10]))
     lo, hi = float(r.lo[0]), float(r.hi[0])
-    assert mpmath.mpf(lo) <= sqrt2 <= mpmath.mpf(hi) and ulps(lo, hi) <= 4
+    assert mpmath.mpf(lo) <= sqrt2 <= mpmath.mpf(hi) and ulps_apart(lo, hi) <= 4
     # sin(x) = 0 on [3, 4]: pi
     r = CtcFwdBwd([Op("sin", (x,)) == 0], ["x"])(Interval([3], [4]))
     assert mp_in(mpmath.pi, float(r.lo[0]), float(r.hi[0])) and float(r.width()[0]) < 1e-14
