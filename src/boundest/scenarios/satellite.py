@@ -127,6 +127,17 @@ def simulate(k_max: int, x0: tuple[float, ...] = X0_TRUE, seed: int | None = 0,
     return x, Measurements(meas - noise, meas + noise, "<simulated>")
 
 
+def _scaled_outputs(meas: Measurements, beta: float) -> tuple[np.ndarray, np.ndarray]:
+    """Output intervals ``mid + beta ([y] - mid)``, rounded outward (beta >= 1 keeps the data)."""
+    mid = 0.5 * (meas.y_lo + meas.y_hi)
+    rad = 0.5 * (meas.y_hi - meas.y_lo)
+    ylo = np.nextafter(mid - beta * rad, -np.inf)
+    yhi = np.nextafter(mid + beta * rad, np.inf)
+    if beta >= 1:
+        ylo, yhi = np.minimum(ylo, meas.y_lo), np.maximum(yhi, meas.y_hi)
+    return ylo, yhi
+
+
 def build_model(meas: Measurements, beta: float = 1.0, w_bound: float = W_BOUND) -> Model:
     """The CSP of equations 14-16, with perturbation and output intervals scaled by ``beta``
     (seed 000 section 5.2: ``[w] = beta [w]``, ``[y] = mid + beta ([y] - mid)``)."""
@@ -136,13 +147,7 @@ def build_model(meas: Measurements, beta: float = 1.0, w_bound: float = W_BOUND)
     x = [VarFamily(f"x{i}") for i in (1, 2, 3, 4)]
     w = [VarFamily(f"w{i}") for i in (1, 2, 3, 4)]
     y = [VarFamily(f"y{i}") for i in (1, 2, 3)]
-    mid = 0.5 * (meas.y_lo + meas.y_hi)
-    rad = 0.5 * (meas.y_hi - meas.y_lo)
-    # outward rounding of the scaled intervals, so that beta = 1 keeps the data exactly
-    ylo = np.minimum(meas.y_lo, np.nextafter(mid - beta * rad, -np.inf)) if beta >= 1 else (
-        np.nextafter(mid - beta * rad, -np.inf))
-    yhi = np.maximum(meas.y_hi, np.nextafter(mid + beta * rad, np.inf)) if beta >= 1 else (
-        np.nextafter(mid + beta * rad, np.inf))
+    ylo, yhi = _scaled_outputs(meas, beta)
     m = Model()
     for i in range(4):
         m.declare(x[i][0], X0_DOMAINS[i])
@@ -251,16 +256,15 @@ def tune(meas: Measurements, beta_max: float = 16.0, tol: float = 1e-3, rel_eps:
     tape = compile_model(build_model(meas, beta=beta_max))
     w_slots = np.array([tape.slot_of[f"w{i}_{k}"] for k in range(K + 1) for i in (1, 2, 3, 4)])
     y_slots = np.array([tape.slot_of[f"y{i}_{k}"] for k in range(K + 1) for i in (1, 2, 3)])
-    mid = (0.5 * (meas.y_lo + meas.y_hi)).ravel()
-    rad = (0.5 * (meas.y_hi - meas.y_lo)).ravel()
 
     def at(beta: float) -> Tape:
         """The tape with the perturbation and output domains scaled by ``beta``."""
         lo, hi = tape.lo.copy(), tape.hi.copy()
         lo[w_slots] = np.maximum(lo[w_slots], -W_BOUND * beta)
         hi[w_slots] = np.minimum(hi[w_slots], W_BOUND * beta)
-        lo[y_slots] = np.maximum(lo[y_slots], np.nextafter(mid - beta * rad, -np.inf))
-        hi[y_slots] = np.minimum(hi[y_slots], np.nextafter(mid + beta * rad, np.inf))
+        ylo, yhi = _scaled_outputs(meas, beta)
+        lo[y_slots] = np.maximum(lo[y_slots], ylo.ravel())
+        hi[y_slots] = np.minimum(hi[y_slots], yhi.ravel())
         return replace(tape, lo=lo, hi=hi)
 
     t0 = time.perf_counter()
