@@ -3,20 +3,13 @@
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from pathlib import Path
 
 import numpy as np
 
 from . import __version__
-
-
-def _write_json(data: dict, path: str | None) -> None:
-    if path:
-        Path(path).parent.mkdir(parents=True, exist_ok=True)
-        Path(path).write_text(json.dumps(data, indent=2))
-        print(f"wrote {path}")
+from .commands import RUNS, write_json
 
 
 def _demo(args: argparse.Namespace) -> int:
@@ -24,7 +17,6 @@ def _demo(args: argparse.Namespace) -> int:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    import numpy as np
 
     from .plot import plot_boxes
     from .scenarios import function_enclosure as fe
@@ -53,60 +45,8 @@ def _demo(args: argparse.Namespace) -> int:
     png = out / "function_enclosure.png"
     fig.savefig(png, dpi=120)
     print(f"wrote {png}")
-    _write_json(result, args.json)
+    write_json(result, args.json)
     return 0
-
-
-def _run_satellite(args: argparse.Namespace) -> int:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from .interval import Interval
-    from .plot import plot_boxes
-    from .scenarios import satellite as sat
-
-    meas = sat.load(args.data, k_max=args.kmax)
-    print(f"satellite (seed 000): k_max = {meas.k_max}, data {meas.source}")
-    print(f"CSP: {7 * (meas.k_max + 1)} constraints over {11 * meas.k_max + 15} variables; "
-          "first run compiles the propagation kernel (cached afterwards)")
-    res = sat.solve(meas, rel_eps=args.rel_eps)
-    if not res.consistent and args.beta_tuning:
-        print("the CSP is empty: the data contradict the model; beta-tuning ...")
-        bres, res = sat.tune(meas, rel_eps=args.rel_eps)
-        print(f"smallest beta with a non-empty contraction: {bres.beta:.4f} "
-              f"({len(bres.trials)} propagations, {bres.time_s:.2f} s)")
-    if not res.consistent:
-        print("proven INCONSISTENT: no state trajectory satisfies the model and the data "
-              "(rerun with --beta-tuning to relax the perturbation and output bounds)")
-    else:
-        print(f"fixed point reached in {res.time_s:.3f} s ({res.evaluations} node revisions, "
-              f"{res.iterations:.1f} passes equivalent)")
-        for k in (0, meas.k_max):
-            b = res.box(k)
-            print(f"  x({k}) in " + " x ".join(f"[{lo:.4f}, {hi:.4f}]"
-                                               for lo, hi in zip(b.lo, b.hi, strict=True)))
-        w = res.x_hi - res.x_lo
-        print("  mean width over k: " + ", ".join(f"x{i + 1} {np.mean(w[:, i]):.3f}"
-                                                  for i in range(4)))
-        out = Path(args.out)
-        out.mkdir(parents=True, exist_ok=True)
-        fig, ax = plt.subplots(figsize=(6.5, 6))
-        plot_boxes(Interval._new(res.x_lo[:, 0], res.x_hi[:, 0]),
-                   Interval._new(res.x_lo[:, 1], res.x_hi[:, 1]), ax=ax)
-        ax.plot(0, 0, "o", color="tab:green", ms=10, label="earth")
-        ax.set_xlabel("x1")
-        ax.set_ylabel("x2")
-        ax.set_aspect("equal")
-        ax.set_title(f"[x1](k) x [x2](k), k = 0..{meas.k_max + 1} (seed 000, Fig. 4)")
-        ax.legend()
-        fig.tight_layout()
-        png = out / f"satellite_k{meas.k_max}.png"
-        fig.savefig(png, dpi=120)
-        print(f"wrote {png}")
-    _write_json(res.to_json(), args.json)
-    return 0 if res.consistent else 1
 
 
 def _solve(args: argparse.Namespace) -> int:
@@ -125,7 +65,7 @@ def _solve(args: argparse.Namespace) -> int:
         text = "[empty]" if bool(dom.is_empty()) else f"[{float(dom.lo)!r}, {float(dom.hi)!r}]"
         print(f"  {name:<{width}} in {text}")
     if args.json:
-        _write_json({"file": str(args.file), "consistent": res.consistent,
+        write_json({"file": str(args.file), "consistent": res.consistent,
                      "evaluations": res.evaluations, "time_s": res.time_s,
                      "domains": {n: None if bool(d.is_empty()) else [float(d.lo), float(d.hi)]
                                  for n, d in res.domains.items()}}, args.json)
@@ -146,18 +86,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     run = sub.add_parser("run", help="run a seed scenario end to end on its embedded data")
     scen = run.add_subparsers(dest="scenario", required=True)
-    sat = scen.add_parser("satellite", help="seed 000: satellite localisation as a CSP")
-    sat.add_argument("--kmax", type=int, choices=(200, 800), default=200,
-                     help="horizon (default 200)")
-    sat.add_argument("--data", help="measurement CSV (default: the embedded one for --kmax)")
-    sat.add_argument("--rel-eps", type=float, default=1e-3,
-                     help="propagation stops when no domain shrinks by more than this "
-                          "fraction of its width (default 1e-3)")
-    sat.add_argument("--beta-tuning", action="store_true",
-                     help="if the CSP is empty, search the smallest relaxation beta")
-    sat.add_argument("--out", default="out", help="folder for figures (default: out)")
-    sat.add_argument("--json", help="write the enclosures as JSON to this file")
-    sat.set_defaults(func=_run_satellite)
+    for module in RUNS:
+        module.register(scen)
 
     solve = sub.add_parser("solve", help="propagate a model file and print every domain")
     solve.add_argument("file", help="model in the text format (docs: boundest.expr.parser)")

@@ -1,4 +1,4 @@
-"""Figures with matplotlib (imported lazily). Functions take ``ax=None`` and return artists."""
+"""Boxes drawn as rectangles."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ from typing import Any
 
 import numpy as np
 
-from .interval import Interval
+from ..interval import Interval
 
 
 def _axes(ax: Any) -> Any:

@@ -1,0 +1,23 @@
+"""One module per `boundest run` scenario: `register(subparsers)` adds it, `run(args)` runs it.
+
+A scenario module imports matplotlib inside ``run`` only, so that ``boundest --help`` stays fast.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+
+def write_json(data: dict, path: str | None) -> None:
+    """Write ``data`` as indented JSON to ``path`` (if given), creating its folder."""
+    if path:
+        Path(path).parent.mkdir(parents=True, exist_ok=True)
+        Path(path).write_text(json.dumps(data, indent=2))
+        print(f"wrote {path}")
+
+
+from . import satellite  # noqa: E402
+
+# add a scenario by importing its module above and listing it here
+RUNS = [satellite]
