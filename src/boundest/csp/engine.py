@@ -47,16 +47,7 @@ _f_tanh, _f_atan, _f_asin, _f_acos = (el._tanh.bounds, el._atan.bounds, tr._asin
                                       tr._acos.bounds)
 _f_atan2, _f_pow = el._atan2.scalar, el._pow.scalar
 _f_sin, _f_cos, _f_tan = tr._sin.scalar, tr._cos.scalar, tr._tan.bounds
-_f_abs, _f_sign, _f_floor, _f_ceil = (al._abs.scalar, al._sign.scalar, al._floor.scalar,
-                                      al._ceil.scalar)
-_f_pown, _f_min, _f_max = al._pown.scalar, al._min.scalar, al._max.scalar
-_b_neg, _b_sqr, _b_sqrt, _b_abs = (al._neg_rev.scalar, al._sqr_rev.scalar, al._sqrt_rev.scalar,
-                                   al._abs_rev.scalar)
-_b_sign, _b_floor, _b_ceil, _b_pown = (al._sign_rev.scalar, al._floor_rev.scalar,
-                                       al._ceil_rev.scalar, al._pown_rev.scalar)
-_b_add, _b_sub, _b_mul, _b_div = (al._add_rev.scalar, al._sub_rev.scalar, al._mul_rev.scalar,
-                                  al._div_rev.scalar)
-_b_min, _b_max = al._min_rev.scalar, al._max_rev.scalar
+_f_pown, _b_pown = al._pown.scalar, al._pown_rev.scalar
 _b_exp, _b_log, _b_sinh, _b_cosh = (el._exp_rev.scalar, el._log_rev.scalar, el._sinh_rev.scalar,
                                     el._cosh_rev.scalar)
 _b_tanh, _b_atan, _b_atan2, _b_pow = (el._tanh_rev.scalar, el._atan_rev.scalar,
@@ -70,28 +61,7 @@ _b_sin, _b_cos, _b_tan, _b_asin, _b_acos = (tr._sin_rev.scalar, tr._cos_rev.scal
 def _forward(code, xl, xh, yl, yh, p, buf):
     """Image of node ``code`` into ``buf[0:2]``."""
     o0, o1 = buf[0:1], buf[1:2]
-    if code == ADD:
-        buf[0] = _add_lo(xl, xh, yl, yh)
-        buf[1] = _add_hi(xl, xh, yl, yh)
-    elif code == SUB:
-        buf[0] = _sub_lo(xl, xh, yl, yh)
-        buf[1] = _sub_hi(xl, xh, yl, yh)
-    elif code == MUL:
-        buf[0] = _mul_lo(xl, xh, yl, yh)
-        buf[1] = _mul_hi(xl, xh, yl, yh)
-    elif code == DIV:
-        buf[0] = _div_lo(xl, xh, yl, yh)
-        buf[1] = _div_hi(xl, xh, yl, yh)
-    elif code == NEG:
-        buf[0] = -xh
-        buf[1] = -xl
-    elif code == SQR:
-        buf[0] = _sqr_lo(xl, xh)
-        buf[1] = _sqr_hi(xl, xh)
-    elif code == SQRT:
-        buf[0] = _sqrt_lo(xl, xh)
-        buf[1] = _sqrt_hi(xl, xh)
-    elif code == POWN:
+    if code == POWN:
         _f_pown(xl, xh, np.int64(p), o0, o1)
     elif code == EXP:
         buf[0], buf[1] = _f_exp(xl, xh, math.exp(xl), math.exp(xh))
@@ -117,50 +87,20 @@ def _forward(code, xl, xh, yl, yh, p, buf):
         buf[0], buf[1] = _f_cosh(xl, xh, math.cosh(xl), math.cosh(xh))
     elif code == TANH:
         buf[0], buf[1] = _f_tanh(xl, xh, math.tanh(xl), math.tanh(xh))
-    elif code == ABS:
-        _f_abs(xl, xh, o0, o1)
-    elif code == SIGN:
-        _f_sign(xl, xh, o0, o1)
-    elif code == FLOOR:
-        _f_floor(xl, xh, o0, o1)
-    elif code == CEIL:
-        _f_ceil(xl, xh, o0, o1)
     elif code == POW:
         _f_pow(xl, xh, yl, yh, o0, o1)
-    elif code == ATAN2:
+    else:  # ATAN2
         _f_atan2(xl, xh, yl, yh, o0, o1)
-    elif code == MIN:
-        _f_min(xl, xh, yl, yh, o0, o1)
-    else:  # MAX
-        _f_max(xl, xh, yl, yh, o0, o1)
 
 
 @nb.njit(cache=True, error_model="numpy")
 def _backward(code, zl, zh, xl, xh, yl, yh, p, buf):
     """Projections of node ``code`` into ``buf[0:2]`` (x) and ``buf[2:4]`` (y)."""
     o0, o1, o2, o3 = buf[0:1], buf[1:2], buf[2:3], buf[3:4]
-    if code == ADD:
-        _b_add(zl, zh, xl, xh, yl, yh, o0, o1, o2, o3)
-    elif code == SUB:
-        _b_sub(zl, zh, xl, xh, yl, yh, o0, o1, o2, o3)
-    elif code == MUL:
-        _b_mul(zl, zh, xl, xh, yl, yh, o0, o1, o2, o3)
-    elif code == DIV:
-        _b_div(zl, zh, xl, xh, yl, yh, o0, o1, o2, o3)
-    elif code == POW:
+    if code == POW:
         _b_pow(zl, zh, xl, xh, yl, yh, o0, o1, o2, o3)
     elif code == ATAN2:
         _b_atan2(zl, zh, xl, xh, yl, yh, o0, o1, o2, o3)
-    elif code == MIN:
-        _b_min(zl, zh, xl, xh, yl, yh, o0, o1, o2, o3)
-    elif code == MAX:
-        _b_max(zl, zh, xl, xh, yl, yh, o0, o1, o2, o3)
-    elif code == NEG:
-        _b_neg(zl, zh, xl, xh, o0, o1)
-    elif code == SQR:
-        _b_sqr(zl, zh, xl, xh, o0, o1)
-    elif code == SQRT:
-        _b_sqrt(zl, zh, xl, xh, o0, o1)
     elif code == POWN:
         _b_pown(zl, zh, xl, xh, np.int64(p), o0, o1)
     elif code == EXP:
@@ -183,16 +123,74 @@ def _backward(code, zl, zh, xl, xh, yl, yh, p, buf):
         _b_sinh(zl, zh, xl, xh, o0, o1)
     elif code == COSH:
         _b_cosh(zl, zh, xl, xh, o0, o1)
-    elif code == TANH:
+    else:  # TANH
         _b_tanh(zl, zh, xl, xh, o0, o1)
+
+
+@nb.njit(cache=True, inline="always", error_model="numpy")
+def _cap(zl, zh, nl, nh):
+    """``[zl, zh] ∩ [nl, nh]`` where a NaN (empty) image stays NaN."""
+    return (max(nl, zl) if nl == nl else nl), (min(nh, zh) if nh == nh else nh)
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _revise(code, zl, zh, xl, xh, yl, yh, p, buf):
+    """HC4-revise of node ``z = f(x, y)``: ``z ∩= f(x, y)``, then ``(x, y) = f_rev(z, x, y)``.
+
+    Returns the new ``(zl, zh, xl, xh, yl, yh)``. The frequent operations are kernels returning
+    tuples (one dispatch, no memory traffic); the others go through ``buf``.
+    """
+    if code == ADD:
+        zl, zh = _cap(zl, zh, _add_lo(xl, xh, yl, yh), _add_hi(xl, xh, yl, yh))
+        xl, xh, yl, yh = al._add_rev_all(zl, zh, xl, xh, yl, yh)
+    elif code == MUL:
+        zl, zh = _cap(zl, zh, _mul_lo(xl, xh, yl, yh), _mul_hi(xl, xh, yl, yh))
+        xl, xh, yl, yh = al._mul_rev_all(zl, zh, xl, xh, yl, yh)
+    elif code == SUB:
+        zl, zh = _cap(zl, zh, _sub_lo(xl, xh, yl, yh), _sub_hi(xl, xh, yl, yh))
+        xl, xh, yl, yh = al._sub_rev_all(zl, zh, xl, xh, yl, yh)
+    elif code == DIV:
+        zl, zh = _cap(zl, zh, _div_lo(xl, xh, yl, yh), _div_hi(xl, xh, yl, yh))
+        xl, xh, yl, yh = al._div_rev_all(zl, zh, xl, xh, yl, yh)
+    elif code == SQR:
+        zl, zh = _cap(zl, zh, _sqr_lo(xl, xh), _sqr_hi(xl, xh))
+        xl, xh = al._sqr_rev_all(zl, zh, xl, xh)
+    elif code == SQRT:
+        zl, zh = _cap(zl, zh, _sqrt_lo(xl, xh), _sqrt_hi(xl, xh))
+        xl, xh = al._sqrt_rev_all(zl, zh, xl, xh)
+    elif code == NEG:
+        zl, zh = _cap(zl, zh, -xh, -xl)
+        xl, xh = al._neg_rev_all(zl, zh, xl, xh)
+    elif code == MIN:
+        nl, nh = al._min_all(xl, xh, yl, yh)
+        zl, zh = _cap(zl, zh, nl, nh)
+        xl, xh, yl, yh = al._min_rev_all(zl, zh, xl, xh, yl, yh)
+    elif code == MAX:
+        nl, nh = al._max_all(xl, xh, yl, yh)
+        zl, zh = _cap(zl, zh, nl, nh)
+        xl, xh, yl, yh = al._max_rev_all(zl, zh, xl, xh, yl, yh)
     elif code == ABS:
-        _b_abs(zl, zh, xl, xh, o0, o1)
+        nl, nh = al._abs_all(xl, xh)
+        zl, zh = _cap(zl, zh, nl, nh)
+        xl, xh = al._abs_rev_all(zl, zh, xl, xh)
     elif code == SIGN:
-        _b_sign(zl, zh, xl, xh, o0, o1)
+        nl, nh = al._sign_all(xl, xh)
+        zl, zh = _cap(zl, zh, nl, nh)
+        xl, xh = al._sign_rev_all(zl, zh, xl, xh)
     elif code == FLOOR:
-        _b_floor(zl, zh, xl, xh, o0, o1)
-    else:  # CEIL
-        _b_ceil(zl, zh, xl, xh, o0, o1)
+        nl, nh = al._floor_all(xl, xh)
+        zl, zh = _cap(zl, zh, nl, nh)
+        xl, xh = al._floor_rev_all(zl, zh, xl, xh)
+    elif code == CEIL:
+        nl, nh = al._ceil_all(xl, xh)
+        zl, zh = _cap(zl, zh, nl, nh)
+        xl, xh = al._ceil_rev_all(zl, zh, xl, xh)
+    else:
+        _forward(code, xl, xh, yl, yh, p, buf)
+        zl, zh = _cap(zl, zh, buf[0], buf[1])
+        _backward(code, zl, zh, xl, xh, yl, yh, p, buf)
+        xl, xh, yl, yh = buf[0], buf[1], buf[2], buf[3]
+    return zl, zh, xl, xh, yl, yh
 
 
 @nb.njit(cache=True, inline="always", error_model="numpy")
@@ -256,20 +254,17 @@ def propagate_kernel(op, out, a, b, param, lo, hi, ptr, adj, dirty, state, rel_e
         again = (o == ia) | (o == ib) | (ia == ib)
         xl, xh = lo[ia], hi[ia]
         yl, yh = (lo[ib], hi[ib]) if ib >= 0 else (0.0, 0.0)
-        _forward(code, xl, xh, yl, yh, param[i], buf)
+        zl, zh, xl, xh, yl, yh = _revise(code, lo[o], hi[o], xl, xh, yl, yh, param[i], buf)
+        # when o aliases an argument, each update is still a sound intersection
         nch = 0
-        r = _update(o, buf[0], buf[1], lo, hi, rel_eps)
+        r = _update(o, zl, zh, lo, hi, rel_eps)
         if r < 0:
             status = EMPTY
             break
         if r > 0:
             changed[nch] = o
             nch += 1
-        xl, xh = lo[ia], hi[ia]  # o may alias an argument
-        if ib >= 0:
-            yl, yh = lo[ib], hi[ib]
-        _backward(code, lo[o], hi[o], xl, xh, yl, yh, param[i], buf)
-        r = _update(ia, buf[0], buf[1], lo, hi, rel_eps)
+        r = _update(ia, xl, xh, lo, hi, rel_eps)
         if r < 0:
             status = EMPTY
             break
@@ -277,7 +272,7 @@ def propagate_kernel(op, out, a, b, param, lo, hi, ptr, adj, dirty, state, rel_e
             changed[nch] = ia
             nch += 1
         if ib >= 0:
-            r = _update(ib, buf[2], buf[3], lo, hi, rel_eps)
+            r = _update(ib, yl, yh, lo, hi, rel_eps)
             if r < 0:
                 status = EMPTY
                 break
