@@ -66,7 +66,8 @@ def slot_users(tape: Tape) -> tuple[np.ndarray, np.ndarray]:
 
 def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
               max_evaluations: int | None = None, domains: dict[str, Interval] | None = None,
-              progress: bool | None = None, chunk: int = 2_000_000) -> Propagation:
+              progress: bool | None = None, chunk: int = 2_000_000, window: int = 64
+              ) -> Propagation:
     """Contract all domains of a CSP to a fixed point.
 
     Stopping rule: a node is revised again only when one of its slots shrank by more than
@@ -85,9 +86,17 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
         Domains overriding the model's initial ones (by variable name).
     progress : bool, optional
         Show a progress bar (default: only when the run lasts more than 2 s).
+    chunk : int
+        Node revisions per call of the compiled kernel (between progress updates).
+    window : int
+        Consecutive tape nodes brought to their local fixed point together before a pass moves
+        on (see ``engine.propagate_kernel``); 64 nodes is about three time steps of the
+        satellite.
     """
     if not 0.0 <= rel_eps < 1.0:
         raise ValueError(f"rel_eps must lie in [0, 1[, got {rel_eps}")
+    if window < 1:
+        raise ValueError(f"window must be a positive number of nodes, got {window}")
     tape = model if isinstance(model, Tape) else compile_model(model)
     lo, hi = tape.lo.copy(), tape.hi.copy()
     for name, dom in (domains or {}).items():
@@ -106,13 +115,14 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
     state = np.array([0, n, RUNNING, 0, 1], dtype=np.int64)
     # a zero-budget call compiles (first use) or loads the kernel outside the timed part
     propagate_kernel(tape.op, tape.out, tape.a, tape.b, tape.param, lo, hi, ptr, adj, dirty,
-                     state.copy(), rel_eps, 0)
+                     state.copy(), rel_eps, 0, window)
     t0 = time.perf_counter()
     status = EMPTY if np.isnan(lo).any() or (lo > hi).any() else RUNNING
     bar = None
     while status == RUNNING and state[3] < budget and n > 0:
         status = propagate_kernel(tape.op, tape.out, tape.a, tape.b, tape.param, lo, hi, ptr,
-                                  adj, dirty, state, rel_eps, min(chunk, budget - state[3]))
+                                  adj, dirty, state, rel_eps, min(chunk, budget - state[3]),
+                                  window)
         if bar is None and status == RUNNING and (progress or (
                 progress is None and time.perf_counter() - t0 > 2.0)):
             from tqdm import tqdm
