@@ -4,17 +4,34 @@ Numba keys its on-disk cache of a compiled function on the file that defines it,
 helpers it inlines from other files. After editing ``rounding.py`` (say), the kernels in
 ``arith.py`` would be loaded from cache with the old helpers, wrong or even crashing. At import,
 boundest hashes every source file that uses Numba; when the hash differs from the one recorded
-beside the cache, the package's cached machine code is dropped and recompiled on demand.
-(This covers the default cache location, ``__pycache__`` beside the sources; with
-``NUMBA_CACHE_DIR`` set, clear that folder yourself after editing kernels.)
+beside the cache, the package's cached machine code is dropped and recompiled on demand. Both
+cache locations are covered: ``__pycache__`` beside the sources, and the folders Numba makes
+under ``NUMBA_CACHE_DIR`` when that is set (one per source folder, named
+``<folder>_<sha1 of its absolute path>``).
 """
 
 from __future__ import annotations
 
 import hashlib
+import os
 from pathlib import Path
 
 _PKG = Path(__file__).parent
+
+
+def _cache_folders() -> tuple[list[Path], Path]:
+    """The folders that may hold the package's cache files, and where to keep the stamp."""
+    root = os.environ.get("NUMBA_CACHE_DIR")
+    if not root:
+        return [_PKG], _PKG / "__pycache__" / "numba-sources.sha256"
+    base = Path(os.path.abspath(root))
+    folders = []
+    for src_dir in sorted({p.parent for p in _PKG.rglob("*.py")}):
+        sub = os.path.abspath(src_dir)
+        name = f"{os.path.basename(sub)}_{hashlib.sha1(sub.encode()).hexdigest()}"
+        folders.append(base / name)
+    pkg = os.path.abspath(_PKG)
+    return folders, base / f"boundest_{hashlib.sha1(pkg.encode()).hexdigest()}.sha256"
 
 
 def drop_stale_numba_cache() -> None:
@@ -25,13 +42,14 @@ def drop_stale_numba_cache() -> None:
         if b"numba" in text:
             digest.update(src.relative_to(_PKG).as_posix().encode())
             digest.update(text)
-    stamp = _PKG / "__pycache__" / "numba-sources.sha256"
+    folders, stamp = _cache_folders()
     try:
         if stamp.exists() and stamp.read_text() == digest.hexdigest():
             return
-        for f in (*_PKG.rglob("*.nbi"), *_PKG.rglob("*.nbc")):
-            f.unlink(missing_ok=True)
-        stamp.parent.mkdir(exist_ok=True)
+        for folder in folders:
+            for f in (*folder.rglob("*.nbi"), *folder.rglob("*.nbc")):
+                f.unlink(missing_ok=True)
+        stamp.parent.mkdir(parents=True, exist_ok=True)
         stamp.write_text(digest.hexdigest())
     except OSError:  # read-only install: Numba then caches elsewhere or not at all
         pass
