@@ -1,5 +1,6 @@
 """Figures with matplotlib (imported lazily). Functions take ``ax=None`` and return artists."""
 
 from .boxes import plot_boxes
+from .paving import plot_paving
 
-__all__ = ["plot_boxes"]
+__all__ = ["plot_boxes", "plot_paving"]

@@ -1,0 +1,7 @@
+"""Set domains: SIVIA, subpavings and images of subpavings (seed 002)."""
+
+from .image import image
+from .sivia import separators, sivia
+from .subpaving import Subpaving, box_difference
+
+__all__ = ["Subpaving", "box_difference", "image", "separators", "sivia"]

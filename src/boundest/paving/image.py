@@ -1,0 +1,194 @@
+"""Image of a subpaving by a function: IMAGESP (seed 002, Remark 3).
+
+``image(sp, f, eps)`` bisects the boxes of ``sp`` (all at once, level by level) until each image
+box ``f([x])`` has its widest side at most ``eps``, then paves the union of the image boxes on a
+regular grid: the cells of step ``h = 2^floor(log2 eps)`` that each image box meets. A cell is
+``[i h, (i + 1) h]`` with ``i`` an integer, exact in float64, and the cells an image box meets
+cover it, so the result contains ``f(V)`` for ``V`` the inside and boundary boxes of ``sp``.
+
+``f`` is a vectorised interval function: it takes an ``Interval`` of shape ``(b, n)`` and
+returns an ``Interval`` of shape ``(b, m)`` built with boundest's interval operators, so that
+the image of every box is one batched call.
+
+Examples
+--------
+>>> from boundest import interval as iv
+>>> from boundest.interval import Interval
+>>> def f(x):  # x -> 3 (sin(x1 + x2), cos(x1 + x2)), seed 002 equation 21
+...     s = x[:, 0] + x[:, 1]
+...     return Interval._new(np.stack([(3 * iv.sin(s)).lo, (3 * iv.cos(s)).lo], axis=1),
+...                          np.stack([(3 * iv.sin(s)).hi, (3 * iv.cos(s)).hi], axis=1))
+>>> v = Subpaving.from_box(Interval([-0.1, -0.1], [0.1, 0.1]))
+>>> w = image(v, f, eps=0.05)
+>>> int(w.contains(np.array([[0.0, 3.0]]))[0]), bool(w.inside.any())
+(0, False)
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Callable
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..interval import Interval
+from .subpaving import Subpaving, _subtract
+
+__all__ = ["cell_range", "grid_step", "image", "pave"]
+
+#: grid indices must stay exact integers in float64
+_MAX_INDEX = 2.0**52
+
+
+def _images(f: Callable[[Interval], Interval], x: Interval, m: int | None) -> Interval:
+    y = f(x)
+    if not isinstance(y, Interval) or y.ndim != 2 or y.shape[0] != x.shape[0] or (
+            m is not None and y.shape[1] != m):
+        raise ValueError(f"f must map boxes of shape {x.shape} to an Interval of shape "
+                         f"({x.shape[0]}, m), got {type(y).__name__} {getattr(y, 'shape', '')}")
+    return y
+
+
+def grid_step(eps: float) -> float:
+    """The step ``h`` of the grid of ``image`` for a precision ``eps``: the largest power of two
+    not above ``eps``."""
+    h = float(2.0 ** np.floor(np.log2(eps)))
+    return h / 2.0 if h > eps else h
+
+
+def cell_range(lo: NDArray, hi: NDArray, h: float) -> tuple[NDArray, NDArray]:
+    """First and last indices (floats) of the grid cells ``[i h, (i + 1) h]`` that cover the
+    boxes ``[lo, hi]``: ``floor(lo / h)`` to ``max(ceil(hi / h) - 1, floor(lo / h))`` (NaN for
+    empty boxes). ``h`` is a power of two: the quotients are exact unless they underflow, and
+    the products ``i h`` checked below are exact while the indices stay below ``2^52``."""
+    with np.errstate(invalid="ignore"):
+        ilo = np.floor(lo / h)
+        ilo = np.where(ilo * h > lo, ilo - 1, ilo)  # a negative quotient rounded to -0
+        ihi = np.ceil(hi / h) - 1
+        ihi = np.where((ihi + 1) * h < hi, ihi + 1, ihi)  # a positive one rounded to +0
+    return ilo, np.maximum(ihi, ilo)
+
+
+def _unique_rows(idx: NDArray[np.int64]) -> NDArray[np.int64]:
+    """The distinct rows of ``idx`` in lexicographic order: one flat key per row over the rows'
+    bounding grid, deduplicated by an occupancy array when that grid is small (else sorted)."""
+    base = idx.min(axis=0)
+    ext = idx.max(axis=0) - base + 1
+    size = 1
+    for e in ext.tolist():
+        size *= e
+    if size >= 2**62:
+        return np.unique(idx, axis=0)
+    key = np.ravel_multi_index(tuple((idx - base).T), tuple(ext.tolist()))
+    if size <= max(8 * idx.shape[0], 1 << 16):
+        occ = np.zeros(size, dtype=bool)
+        occ[key] = True
+        key = np.flatnonzero(occ)
+    else:
+        key = np.unique(key)
+    return np.stack(np.unravel_index(key, tuple(ext.tolist())), axis=1) + base
+
+
+def pave(y: Interval, eps: float) -> Subpaving:
+    """An outer subpaving of the union of the boxes ``y`` ``(b, m)``, on the grid of ``image``.
+
+    Boxes that meet at most 3 cells per dimension are replaced by those cells; the others (and
+    unbounded ones) by their hull, cut out of the cells. Empty boxes are ignored.
+    """
+    y = y[~np.isnan(y.lo).any(axis=1)]
+    m = y.shape[1]
+    lo, hi = y.lo, y.hi
+    h = grid_step(eps)
+    # the image may be far from the origin: coarsen the grid until every index is exact
+    big = max(float(np.abs(lo[np.isfinite(lo)]).max(initial=0.0)),
+              float(np.abs(hi[np.isfinite(hi)]).max(initial=0.0)))
+    while big / h >= _MAX_INDEX:
+        h *= 2.0
+    ilo, ihi = cell_range(lo, hi, h)
+    with np.errstate(invalid="ignore"):
+        k = ihi - ilo + 1  # cells per dimension
+        snap = np.all(np.isfinite(k) & (k <= 3), axis=1)
+    ilo, k = ilo[snap].astype(np.int64), k[snap].astype(np.int64)
+    cells = []
+    for off in itertools.product(range(3), repeat=m):  # 3^m offsets, not a loop over boxes
+        o = np.asarray(off, dtype=np.int64)
+        cells.append(ilo[np.all(o < k, axis=1)] + o)
+    idx = np.concatenate(cells).reshape(-1, m)
+    if idx.shape[0]:
+        idx = _unique_rows(idx)
+    clo, chi = idx * h, (idx + 1) * h
+    if not snap.all():  # wide or unbounded images: their hull, cut out of the cells
+        rlo = lo[~snap].min(axis=0, keepdims=True)
+        rhi = hi[~snap].max(axis=0, keepdims=True)
+        clo, chi, _ = _subtract(clo, chi, rlo, rhi)
+        clo, chi = np.concatenate([clo, rlo]), np.concatenate([chi, rhi])
+    out = Subpaving(Interval._new(clo, chi), np.zeros(clo.shape[0], dtype=bool))
+    out.stats = {"images": int(lo.shape[0]), "cells": int(idx.shape[0])}
+    return out
+
+
+def image(sp: Subpaving, f: Callable[[Interval], Interval], *, eps: float,
+          max_boxes: int = 1_000_000, extra: Interval | None = None) -> Subpaving:
+    """A subpaving guaranteed to contain ``f(V)``, ``V`` the inside and boundary boxes of ``sp``.
+
+    Parameters
+    ----------
+    sp : Subpaving
+        The set ``V``.
+    f : callable
+        Vectorised interval function, ``Interval (b, n) -> Interval (b, m)``.
+    eps : float
+        Target width of the image boxes and step (rounded down to a power of two) of the grid.
+    max_boxes : int
+        Budget of boxes of ``V`` bisected; beyond it the remaining images are paved as they
+        are (still enclosures, only wider).
+    extra : Interval, optional
+        Boxes ``(e, m)`` already known to enclose part of the image (computed by the caller),
+        paved together with the images.
+
+    Returns
+    -------
+    Subpaving
+        Boundary boxes only (an outer approximation), made by ``pave``. Image boxes wider than
+        3 grid cells (budget exhausted) or unbounded are replaced by their hull, cut out of the
+        grid cells. ``stats`` holds ``bisected`` (boxes of ``V`` after bisection), ``images`` and
+        ``cells``.
+    """
+    if not isinstance(sp, Subpaving):
+        raise ValueError(f"image needs a Subpaving, got {type(sp).__name__}")
+    if not (np.isfinite(eps) and eps > 0):
+        raise ValueError(f"eps must be a positive finite number, got {eps}")
+    m: int | None = None
+    done: list[Interval] = []
+    if extra is not None:
+        if not isinstance(extra, Interval) or extra.ndim != 2:
+            raise ValueError(f"extra must be an Interval of shape (e, m), got "
+                             f"{getattr(extra, 'shape', type(extra).__name__)}")
+        m = extra.shape[1]
+        done.append(extra)
+    frontier = sp.boxes
+    count = 0
+    while frontier.shape[0]:
+        y = _images(f, frontier, m)
+        m = y.shape[1]
+        empty = np.isnan(y.lo).any(axis=1)  # f is undefined on the whole box
+        wide = (y.max_diam() > eps) & ~empty & (frontier.max_diam() > 0)
+        ok = ~wide & ~empty
+        done.append(y[ok])
+        count += int(ok.sum())
+        if count + 2 * int(wide.sum()) > max_boxes:
+            done.append(y[wide])
+            count += int(wide.sum())
+            break
+        left, right = frontier[wide].bisect()
+        frontier = Interval._new(np.concatenate([left.lo, right.lo]),
+                                 np.concatenate([left.hi, right.hi]))
+    if m is None:  # sp is empty: so is its image (of unknown dimension: keep sp's)
+        out = Subpaving.empty(sp.dim)
+        out.stats = {"bisected": 0, "images": 0, "cells": 0}
+        return out
+    out = pave(Interval._new(np.concatenate([d.lo for d in done]).reshape(-1, m),
+                             np.concatenate([d.hi for d in done]).reshape(-1, m)), eps)
+    out.stats = {"bisected": count, **out.stats}
+    return out
