@@ -17,7 +17,7 @@ def write_json(data: dict, path: str | None) -> None:
         print(f"wrote {path}")
 
 
-from . import satellite  # noqa: E402
+from . import jaulin2001, satellite  # noqa: E402
 
 # add a scenario by importing its module above and listing it here
-RUNS = [satellite]
+RUNS = [satellite, jaulin2001]
