@@ -1,0 +1,307 @@
+"""Tube contractors: CtcDeriv, CtcEval, CtcSlices and the contractor network.
+
+Soundness: random smooth trajectories (tests/test_tube.py ``Traj``) lie in random tubes whose
+derivative tubes enclose their exact derivatives; no contractor may remove them (checked exactly
+with mpmath at the gates and at random times). Tightness and emptiness cases are derived by
+hand in the comments.
+"""
+
+from __future__ import annotations
+
+import math
+from fractions import Fraction
+
+import mpmath
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from boundest import Interval, Var
+from boundest.tube import ContractorNetwork, CtcDeriv, CtcEval, CtcSlices, Tube
+
+from .test_tube import grids, inside, sample_times, seeds, trajectories, tube_around, tube_keeps
+
+INF = math.inf
+
+
+# -- CtcDeriv --
+@settings(max_examples=60)
+@given(trajectories(), grids(), seeds, st.sampled_from([0.0, 0.05, 0.5]))
+def test_deriv_keeps_truth(tr, t, seed, p_entire):
+    rng = np.random.default_rng(seed)
+    x = tube_around(tr, t, rng, p_entire)
+    v = tube_around(tr, t, rng, p_entire / 5, deriv=True)
+    CtcDeriv().contract(x, v)
+    assert not x.is_empty()
+    assert tube_keeps(x, tr, sample_times(t, rng))
+
+
+@settings(max_examples=30)
+@given(trajectories(), trajectories(), grids(), seeds)
+def test_deriv_vector_keeps_truth(tr1, tr2, t, seed):
+    rng = np.random.default_rng(seed)
+    v = Tube.stack([tube_around(tr1, t, rng, deriv=True), tube_around(tr2, t, rng, deriv=True)])
+    # only the initial gates are known (widened): x is entire elsewhere
+    x = Tube(t, Interval.entire((t.size - 1, 2)))
+    t0 = Interval(t[0], t[0])
+    x.gates[0] = Interval([float(tr1.enclose(t0).lo), float(tr2.enclose(t0).lo)],
+                          [float(tr1.enclose(t0).hi), float(tr2.enclose(t0).hi)]).inflate(0.1)
+    CtcDeriv().contract(x, v)
+    times = sample_times(t, rng, 20)
+    assert tube_keeps(x[0], tr1, times) and tube_keeps(x[1], tr2, times)
+    assert np.all(np.isfinite(x.gates.lo))  # the initial gates bound everything
+
+
+def test_deriv_tight_on_unit_slope():
+    # x' = 1, x(0) = 0 on 1000 slices of [0, 10]: x(t_i) = t_i up to rounding, slices exact
+    x = Tube.constant(0, 10, 1000, Interval.entire())
+    x.gates[0] = Interval(0.0, 0.0)
+    CtcDeriv().contract(x, Tube.constant(0, 10, 1000, Interval(1.0, 1.0)))
+    err = np.maximum(np.abs(x.gates.lo - x.t), np.abs(x.gates.hi - x.t))
+    assert np.all(x.gates.lo <= x.t) and np.all(x.t <= x.gates.hi)
+    assert err.max() < 1e-12
+    assert np.all(np.abs(x.slices.lo - x.t[:-1]) < 1e-12)
+    assert np.all(np.abs(x.slices.hi - x.t[1:]) < 1e-12)
+
+
+def test_deriv_polygon_slice():
+    # gates 0 at both ends of [0, 1], |x'| <= 1: x(s) <= min(s, 1 - s) <= 1/2 (box: 1)
+    x = Tube([0.0, 1.0], Interval([-5.0], [5.0]), Interval([0.0, 0.0], [0.0, 0.0]))
+    CtcDeriv().contract(x, Tube([0.0, 1.0], Interval([-1.0], [1.0])))
+    assert 0.5 <= float(x.slices.hi[0]) < 0.5 + 1e-15
+    assert -0.5 - 1e-15 < float(x.slices.lo[0]) <= -0.5
+    # asymmetric: x' in [0, 2], x(0) in [0, 1], x(1) in [1.5, 2]: upper = min(1 + 2s, 2) = 2,
+    # lower = max(0, 1.5 - 2(1 - s)) = 0 at s = 0
+    x = Tube([0.0, 1.0], Interval([-5.0], [5.0]), Interval([0.0, 1.5], [1.0, 2.0]))
+    CtcDeriv().contract(x, Tube([0.0, 1.0], Interval([0.0], [2.0])))
+    assert float(x.slices.lo[0]) == 0.0 and float(x.slices.hi[0]) == 2.0
+
+
+def test_deriv_backward_and_empty():
+    # x(10) = 0, x' in [1, 2]: backward, x(0) in [-20, -10]
+    x = Tube.constant(0, 10, 100, Interval.entire())
+    x.gates[100] = Interval(0.0, 0.0)
+    CtcDeriv().contract(x, Tube.constant(0, 10, 100, Interval(1.0, 2.0)))
+    g = x.gates[0]
+    assert -20 - 1e-12 < float(g.lo) <= -20 and -10 <= float(g.hi) < -10 + 1e-12
+    # x(0) = 0, x(10) = 0 and x' >= 1: impossible
+    x.gates[0] = Interval(0.0, 0.0)
+    CtcDeriv().contract(x, Tube.constant(0, 10, 100, Interval(1.0, 2.0)))
+    assert x.is_empty()
+    # an empty derivative tube empties x; entire tubes stay entire
+    y = Tube.constant(0, 1, 4)
+    CtcDeriv().contract(y, Tube.constant(0, 1, 4))
+    assert np.all(y.slices.is_entire()) and np.all(y.gates.is_entire())
+    v = Tube.constant(0, 1, 4, Interval(0, 1))
+    v.set_empty()
+    CtcDeriv().contract(y, v)
+    assert y.is_empty()
+    with pytest.raises(ValueError, match="gate times"):
+        CtcDeriv().contract(y, Tube.constant(0, 1, 5))
+
+
+# -- CtcEval --
+@settings(max_examples=60)
+@given(trajectories(), grids(), seeds, st.floats(0, 1), st.floats(0, 0.3), st.floats(0, 1))
+def test_eval_keeps_truth(tr, t, seed, where, trad, zrad):
+    rng = np.random.default_rng(seed)
+    y = tube_around(tr, t, rng, p_entire=0.2)
+    w = tube_around(tr, t, rng, p_entire=0.02, deriv=True)
+    ts = float(t[0] + where * (t[-1] - t[0]))
+    if rng.random() < 0.2:
+        ts = float(t[rng.integers(t.size)])  # a measurement at a gate time
+    span = trad * (t[-1] - t[0])
+    tm = Interval(max(t[0], ts - span * rng.random()), min(t[-1], ts + span * rng.random()))
+    zt = tr.value(ts)
+    z = Interval(float(zt) - zrad * rng.random() - 1e-9, float(zt) + zrad * rng.random() + 1e-9)
+    if rng.random() < 0.3:
+        tm = Interval(ts, ts)
+    tm, z = CtcEval().contract(tm, z, y, w)
+    assert inside(tm, mpmath.mpf(ts)) and inside(z, zt)
+    assert tube_keeps(y, tr, sample_times(t, rng))
+
+
+@settings(max_examples=60)
+@given(trajectories(), grids(), seeds, st.floats(0, 1), st.floats(0, 1), st.floats(0, 1),
+       st.sampled_from([0.0, 1e-6, 1e-3, 1e-2, 0.1, 0.5]))
+def test_eval_on_entire_tube_keeps_truth(tr, t, seed, where, left, right, zrad):
+    # only the measurement and the derivative bound y: the contracted tube is the envelope of
+    # the trajectories through [t] x [z], the sharpest test of the propagation
+    rng = np.random.default_rng(seed)
+    y = Tube(t, Interval.entire(t.size - 1))
+    w = tube_around(tr, t, rng, deriv=True)
+    ts = float(t[0] + where * (t[-1] - t[0]))
+    tm = Interval(ts - left * (ts - t[0]), ts + right * (t[-1] - ts))
+    zt = tr.value(ts)
+    z = Interval(float(zt) - zrad - 1e-9, float(zt) + zrad + 1e-9)
+    tm, z = CtcEval().contract(tm, z, y, w)
+    assert inside(tm, mpmath.mpf(ts)) and inside(z, zt)
+    assert np.all(np.isfinite(y.gates.lo)) and np.all(np.isfinite(y.slices.hi))
+    assert tube_keeps(y, tr, sample_times(t, rng))
+
+
+@settings(max_examples=30)
+@given(trajectories(), grids(), seeds, st.floats(0, 1))
+def test_eval_then_deriv_keep_truth(tr, t, seed, where):
+    # entire tube, one exact-time measurement, then CtcDeriv: the truth survives both
+    rng = np.random.default_rng(seed)
+    y = Tube.constant(t[0], t[-1], 1, Interval.entire())
+    y = Tube(t, Interval.entire(t.size - 1))
+    w = tube_around(tr, t, rng, deriv=True)
+    ts = float(t[0] + where * (t[-1] - t[0]))
+    zt = tr.value(ts)
+    z = Interval(float(zt) - 0.1, float(zt) + 0.1)
+    tm = Interval(max(t[0], ts - 0.5), min(t[-1], ts + 0.5))
+    CtcEval().contract(tm, z, y, w)
+    assert np.all(np.isfinite(y.gates.lo))  # the measurement bounds the whole tube
+    CtcDeriv().contract(y, w)
+    assert tube_keeps(y, tr, sample_times(t, rng))
+
+
+def test_eval_by_hand():
+    # y' = 1, y in [-10, 10], y(t) = 0 for some t in [2, 8]: y(s) = s - t1, t1 in [2, 8]
+    y = Tube.constant(0, 10, 100, Interval(-10, 10))
+    w = Tube.constant(0, 10, 100, Interval(1, 1))
+    t, z = CtcEval().contract(Interval(2, 8), Interval(0, 0), y, w)
+    assert float(t.lo) == 2 and float(t.hi) == 8 and float(z.lo) == 0 == float(z.hi)
+    e9, e1, e5 = y(9.0), y(1.0), y(5.0)
+    assert 1 - 1e-9 < float(e9.lo) <= 1 and 7 <= float(e9.hi) < 7 + 1e-9
+    assert -7 - 1e-9 < float(e1.lo) <= -7 and -1 <= float(e1.hi) < -1 + 1e-9
+    assert -3 - 1e-9 < float(e5.lo) <= -3 and 3 <= float(e5.hi) < 3 + 1e-9
+    # a second measurement: y(t) in [3, 3.5] for t in [4, 9]; trajectories s - t1 reach 3 at
+    # t1 + 3 in [5, 11]: t contracts to [5 - dt, 9]
+    t2, _ = CtcEval().contract(Interval(4, 9), Interval(3, 3.5), y, w)
+    assert 4.8 <= float(t2.lo) <= 5.0 and float(t2.hi) == 9
+
+
+def test_eval_degenerate_and_unbounded():
+    # y' = 1 and y(5) = 0 exactly (a gate time): y(t_i) = t_i - 5 at every gate, to rounding
+    y = Tube.constant(0, 10, 100, Interval.entire())
+    w = Tube.constant(0, 10, 100, Interval(1, 1))
+    t, z = CtcEval().contract(Interval(5, 5), Interval(0, 0), y, w)
+    assert float(t.lo) == 5 == float(t.hi) and float(z.lo) == 0 == float(z.hi)
+    exact = y.t - 5
+    assert np.all(y.gates.lo <= exact) and np.all(exact <= y.gates.hi)
+    assert np.max(y.gates.hi - y.gates.lo) < 1e-13
+    # the same at a time inside slice 50 = [t_50, t_51] ~ [5, 5.1]: y(s) = s - 5.05 there, so
+    # the slice becomes [t_50 - 5.05, t_51 - 5.05] (the polygon; the box alone gives +-0.1)
+    y = Tube.constant(0, 10, 100, Interval.entire())
+    CtcEval().contract(Interval(5.05, 5.05), Interval(0, 0), y, w)
+    s = y.slices[50]
+    lo, hi = Fraction(y.t[50]) - Fraction(5.05), Fraction(y.t[51]) - Fraction(5.05)
+    assert lo - Fraction(1e-13) < Fraction(float(s.lo)) <= lo
+    assert hi <= Fraction(float(s.hi)) < hi + Fraction(1e-13)
+    # an unbounded derivative: y may leave [z] at once, nothing is learnt outside (t1 itself
+    # is unknown in [2, 3], so even the gates inside [t] stay entire)
+    y = Tube.constant(0, 10, 100, Interval.entire())
+    t, z = CtcEval().contract(Interval(2, 3), Interval(0, 1), y, Tube.constant(0, 10, 100))
+    assert float(t.lo) == 2 and float(t.hi) == 3 and float(z.lo) == 0 and float(z.hi) == 1
+    assert np.all(y.gates.is_entire()) and np.all(y.slices.is_entire())
+    # ... but a degenerate time pins the gate there
+    CtcEval().contract(Interval(2, 2), Interval(0, 1), y, Tube.constant(0, 10, 100))
+    assert float(y.gates.lo[20]) == 0 and float(y.gates.hi[20]) == 1
+    assert np.all(y.gates[21:].is_entire())
+
+
+def test_eval_contracts_time_and_value():
+    # y(s) in [s, s + 1] (thin, increasing): y(t) in [5, 5.5] => t in [4, 5.5]
+    t = np.linspace(0, 10, 1001)
+    y = Tube(t, Interval(t[:-1], t[1:] + 1), Interval(t, t + 1))
+    w = Tube.constant(0, 10, 1000, Interval(1, 1))
+    tm, z = CtcEval().contract(Interval(0, 10), Interval(5, 5.5), y, w)
+    assert 3.98 <= float(tm.lo) <= 4.0 and 5.5 <= float(tm.hi) <= 5.52
+    # z contracted by y([t]) when [t] is narrow: y([1, 2]) = [1, 3]
+    tm, z = CtcEval().contract(Interval(1, 2), Interval(-10, 10), y.copy(), w)
+    assert float(z.lo) == 1 and float(z.hi) == 3
+
+
+def test_eval_inconsistent_is_empty():
+    y = Tube.constant(0, 10, 100, Interval(-1, 1))
+    w = Tube.constant(0, 10, 100, Interval(-1, 1))
+    t, z = CtcEval().contract(Interval(2, 3), Interval(5, 6), y, w)
+    assert t.is_empty() and z.is_empty() and y.is_empty()
+    # consistent in value but not with the derivative: y(0) = 0 (gate), y' in [0, 0.1],
+    # y(t) = 5 for t in [1, 2] is out of reach
+    y = Tube.constant(0, 10, 100, Interval(-10, 10))
+    y.gates[0] = Interval(0, 0)
+    w = Tube.constant(0, 10, 100, Interval(0, 0.1))
+    CtcDeriv().contract(y, w)
+    t, z = CtcEval().contract(Interval(1, 2), Interval(5, 5), y, w)
+    assert t.is_empty() and y.is_empty()
+    # a time outside the domain
+    y = Tube.constant(0, 10, 100, Interval(-10, 10))
+    t, z = CtcEval().contract(Interval(20, 30), Interval(0, 1), y, w)
+    assert t.is_empty() and y.is_empty()
+
+
+def test_eval_vector():
+    # y = (s, -s) thin; measurement (5, -5) +- 0.1 at t in [0, 10] => t near 5
+    t = np.linspace(0, 10, 101)
+    y = Tube.stack([Tube(t, Interval(t[:-1], t[1:])), Tube(t, Interval(-t[1:], -t[:-1]))])
+    w = Tube.stack([Tube.constant(0, 10, 100, Interval(1, 1)),
+                    Tube.constant(0, 10, 100, Interval(-1, -1))])
+    tm, _ = CtcEval().contract(Interval(0, 10), Interval([4.9, -5.1], [5.1, -4.9]), y, w)
+    assert 4.7 <= float(tm.lo) <= 4.9 and 5.1 <= float(tm.hi) <= 5.3
+
+
+# -- CtcSlices and the network --
+def test_ctc_slices_with_parameter():
+    x, v, p = Var("x"), Var("v"), Var("p")
+    ctc = CtcSlices([v == p * x], ["x", "v", "p"])
+    X = Tube.constant(0, 1, 10, Interval(1, 2))
+    V = Tube.constant(0, 1, 10, Interval(-10, 10))
+    P = Interval(-1, 3)
+    ctc.contract(X, V, P)
+    assert float(V(0.5).lo) == -2 and float(V(0.5).hi) == 6
+    V2 = Tube.constant(0, 1, 10, Interval(2, 3))
+    ctc.contract(X, V2, P)  # p = v / x in [1, 3]
+    assert float(P.lo) == 1 and float(P.hi) == 3
+    ctc.contract(X, Tube.constant(0, 1, 10, Interval(10, 11)), P)  # p would be >= 5
+    assert P.is_empty() and X.is_empty()
+
+
+@settings(max_examples=15)
+@given(trajectories(), grids(), seeds)
+def test_network_keeps_truth(tr, t, seed):
+    # x' = v, v = u (u the exact derivative enclosure), two measurements, x otherwise unknown
+    rng = np.random.default_rng(seed)
+    u = tube_around(tr, t, rng, deriv=True)
+    x = Tube(t, Interval.entire(t.size - 1))
+    v = Tube(t, Interval.entire(t.size - 1))
+    cn = ContractorNetwork()
+    cn.add(CtcSlices([Var("v") == Var("u")], ["v", "u"]), [v, u])
+    cn.add(CtcDeriv(), [x, v])
+    meas = []
+    for s in rng.uniform(t[0], t[-1], 2):
+        zt = float(tr.value(float(s)))
+        tm = Interval(max(t[0], s - 0.3), min(t[-1], s + 0.3))
+        z = Interval(zt - 0.2, zt + 0.2)
+        meas.append((float(s), tm, z))
+        cn.add(CtcEval(), [tm, z, x, v])
+    report = cn.contract(rel_eps=1e-6, max_iter=50, progress=False)
+    assert not report.empty and report.iterations == len(report.contraction) >= 2
+    assert report.converged or report.iterations == 50
+    assert np.all(np.isfinite(x.gates.lo))
+    assert tube_keeps(x, tr, sample_times(t, rng, 20))
+    for s, tm, _ in meas:
+        assert inside(tm, mpmath.mpf(s))
+
+
+def test_network_report_and_errors():
+    x = Tube.constant(0, 1, 10, Interval.entire())
+    x.gates[0] = Interval(0, 0)
+    v = Tube.constant(0, 1, 10, Interval(-1, 1))
+    cn = ContractorNetwork()
+    cn.add(CtcDeriv(), [x, v])
+    r = cn.contract()
+    # iteration 1 bounds the 10 slices and the 10 unknown gates; iteration 2 changes nothing
+    assert r.iterations == 2 and r.newly_bounded[0] == 10 + 10 and r.contraction[1] == 0
+    assert r.converged and not r.empty
+    x.gates[10] = Interval(5, 6)  # out of reach with |x'| <= 1
+    r = cn.contract()
+    assert r.empty and r.iterations == 1
+    with pytest.raises(ValueError, match="rel_eps"):
+        cn.contract(rel_eps=2)
+    with pytest.raises(ValueError, match="domains"):
+        cn.add(CtcDeriv(), [x, 3.0])
