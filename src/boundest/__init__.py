@@ -7,7 +7,7 @@ functions that accept intervals and expressions alike (``sin(Interval)`` is an e
 ``from boundest import *``.
 """
 
-from .csp import BetaResult, Propagation, beta_tuning, propagate  # noqa: F401
+from .csp import Arc, BetaResult, Propagation, TreeSCSP, beta_tuning, propagate  # noqa: F401
 from .ctc import (  # noqa: F401
     Contractor,
     CtcFwdBwd,
@@ -17,6 +17,7 @@ from .ctc import (  # noqa: F401
     Sequence,
     Union,
 )
+from .estimation import ChainEstimate, DiscreteSystem, cse, ncse, rcse  # noqa: F401
 from .expr import (  # noqa: F401
     Constraint,
     Model,
@@ -30,6 +31,16 @@ from .expr import functions as _functions
 from .interval import *  # noqa: F403
 from .interval import IntervalVector
 from .interval import __all__ as _interval_all
+from .paving import Subpaving, image, separators, sivia  # noqa: F401
+from .tube import (  # noqa: F401
+    ContractorNetwork,
+    CtcDeriv,
+    CtcEval,
+    CtcSlices,
+    NetworkReport,
+    Tube,
+    TubeVector,
+)
 
 # the dispatching functions replace the interval-only ones of the same name
 globals().update({name: getattr(_functions, name) for name in _functions.__all__})
@@ -42,4 +53,7 @@ __all__ = list(dict.fromkeys([
     *_interval_all, *_functions.__all__, "Box", "__version__", "BetaResult", "Propagation",
     "beta_tuning", "propagate", "Contractor", "CtcFwdBwd", "Fixpoint", "FunctionContractor",
     "Inflate", "Sequence", "Union", "Constraint", "Model", "ModelSyntaxError", "Var",
-    "VarFamily", "load_model", "parse_model"]))
+    "VarFamily", "load_model", "parse_model", "Arc", "TreeSCSP", "ChainEstimate",
+    "DiscreteSystem", "cse", "ncse", "rcse", "Subpaving", "image", "separators", "sivia",
+    "ContractorNetwork", "CtcDeriv", "CtcEval", "CtcSlices", "NetworkReport", "Tube",
+    "TubeVector"]))
