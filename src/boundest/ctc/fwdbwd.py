@@ -79,33 +79,52 @@ class CtcFwdBwd(Contractor):
     def contract(self, x: Interval) -> Interval:
         t = self.tape
         batch = x.shape[:-1]
-        lo = np.broadcast_to(t.lo, (*batch, t.n_slots)).copy()
-        hi = np.broadcast_to(t.hi, (*batch, t.n_slots)).copy()
+        # slots first: each node then reads and writes contiguous rows of the batch
+        shape = (t.n_slots, *batch)
+        col = (-1, *([1] * len(batch)))
+        lo = np.broadcast_to(t.lo.reshape(col), shape).copy()
+        hi = np.broadcast_to(t.hi.reshape(col), shape).copy()
+        xlo, xhi = np.moveaxis(x.lo, -1, 0), np.moveaxis(x.hi, -1, 0)
         for j, s in enumerate(self._slots):  # several variables may share a slot
-            lo[..., s] = np.maximum(lo[..., s], x.lo[..., j])
-            hi[..., s] = np.minimum(hi[..., s], x.hi[..., j])
-        bad = lo > hi
+            lo[s] = np.maximum(lo[s], xlo[j])
+            hi[s] = np.minimum(hi[s], xhi[j])
+        bad = ~(lo <= hi)
+        bad |= bad.any(axis=0)
         lo[bad] = hi[bad] = np.nan
-        dom = _empty_rows(Interval._new(lo, hi))
+
+        def dom(s: int) -> Interval:
+            return Interval._new(lo[s], hi[s])
+
+        def put(s: int, v: Interval) -> None:
+            lo[s], hi[s] = v.lo, v.hi
+
         for i, name in enumerate(self._codes):  # forward: images
             o, a, b = t.out[i], t.a[i], t.b[i]
             if name == "pown":
-                img = FORWARD[name](dom[..., a], t.param[i])
+                img = FORWARD[name](dom(a), t.param[i])
             elif b < 0:
-                img = FORWARD[name](dom[..., a])
+                img = FORWARD[name](dom(a))
             else:
-                img = FORWARD[name](dom[..., a], dom[..., b])
-            dom[..., o] = iv.intersect(dom[..., o], img)
+                img = FORWARD[name](dom(a), dom(b))
+            put(o, iv.intersect(dom(o), img))
         for i in range(t.n_nodes - 1, -1, -1):  # backward: projections
             name, o, a, b = self._codes[i], t.out[i], t.a[i], t.b[i]
             if name == "pown":
-                dom[..., a] = BACKWARD[name](dom[..., o], dom[..., a], t.param[i])
+                put(a, BACKWARD[name](dom(o), dom(a), t.param[i]))
             elif b < 0:
-                dom[..., a] = BACKWARD[name](dom[..., o], dom[..., a])
+                put(a, BACKWARD[name](dom(o), dom(a)))
             else:
-                xa, xb = BACKWARD[name](dom[..., o], dom[..., a], dom[..., b])
-                dom[..., a] = xa if a != b else iv.intersect(xa, xb)
-                if a != b:
-                    dom[..., b] = xb
-        dom = _empty_rows(dom)
-        return _empty_rows(iv.intersect(x, dom[..., self._slots]))
+                xa, xb = BACKWARD[name](dom(o), dom(a), dom(b))
+                if a == b:
+                    put(a, iv.intersect(xa, xb))
+                else:
+                    put(a, xa)
+                    put(b, xb)
+        out = Interval._new(np.moveaxis(lo[self._slots], 0, -1),
+                            np.moveaxis(hi[self._slots], 0, -1))
+        empty = np.isnan(lo).any(axis=0)  # a box with one empty slot is empty
+        res = _empty_rows(iv.intersect(x, out))
+        if empty.any():
+            res.lo[empty] = np.nan
+            res.hi[empty] = np.nan
+        return res
