@@ -137,3 +137,16 @@ def test_equality_is_set_equality():
     assert Interval.empty() == Interval.empty()
     assert Interval(1, 2) != Interval(1, 3)
     assert np.array_equal(Interval([1, 2], [3, 4]) == Interval([1, 0], [3, 4]), [True, False])
+
+
+def test_volume_is_an_upper_bound_of_the_exact_volume():
+    rng = np.random.default_rng(7)
+    lo = rng.uniform(-1, 1, (400, 3)) * 10.0 ** rng.integers(-3, 4, (400, 3))
+    hi = lo + rng.uniform(0, 1, (400, 3)) * 10.0 ** rng.integers(-5, 2, (400, 3))
+    vol = Interval(lo, hi).volume()
+    for b in range(400):
+        exact = Fraction(1)
+        for i in range(3):
+            exact *= Fraction(hi[b, i]) - Fraction(lo[b, i])
+        assert exact <= Fraction(vol[b]) <= exact * (1 + Fraction(1, 2**48))
+    assert Interval([0, 0], [0, 1e300]).volume() == 0.0  # a degenerate box has volume 0

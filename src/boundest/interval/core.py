@@ -263,9 +263,17 @@ class Interval:
         return np.where((self.lo <= 0) & (self.hi >= 0), 0.0, m)
 
     def volume(self) -> NDArray[np.float64]:
-        """Product of the widths over the last axis (a box's volume; 0-d: the width)."""
+        """Product of the widths over the last axis (a box's volume; 0-d: the width), rounded
+        up: an upper bound of the exact volume (0 exactly when a width is 0)."""
+        from .arith import _mul_hi  # arith builds on this module
+
         w = self.width()
-        return w if w.ndim == 0 else np.prod(w, axis=-1)
+        if w.ndim == 0:
+            return w
+        v = w[..., 0].copy()
+        for i in range(1, w.shape[-1]):  # a loop over the dimension, not over boxes
+            v = _mul_hi(v, v, w[..., i], w[..., i])
+        return v
 
     def max_diam(self) -> NDArray[np.float64]:
         """Largest width over the last axis (a box's diameter)."""
