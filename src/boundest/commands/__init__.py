@@ -17,7 +17,7 @@ def write_json(data: dict, path: str | None) -> None:
         print(f"wrote {path}")
 
 
-from . import jaulin2001, satellite  # noqa: E402
+from . import drifting_clock, jaulin2001, range_only, satellite  # noqa: E402
 
 # add a scenario by importing its module above and listing it here
-RUNS = [satellite, jaulin2001]
+RUNS = [satellite, jaulin2001, range_only, drifting_clock]
