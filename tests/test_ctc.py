@@ -71,8 +71,9 @@ def show(t) -> str:
 
 
 def _near(a, target, tol) -> bool:
-    d = abs(a - target)
-    return 0 < d < tol
+    """Whether ``a`` is within ``tol`` of ``target``, equality included: a value that rounded
+    onto ``target`` (1 - 1e-248 onto 1) may lie on either side of it exactly."""
+    return abs(a - target) < tol
 
 
 def mp_eval(t, point: dict[str, mpmath.mpf], scale: list) -> mpmath.mpf:
@@ -96,19 +97,21 @@ def mp_eval(t, point: dict[str, mpmath.mpf], scale: list) -> mpmath.mpf:
         elif name == "sqr":
             v = a * a
         elif name == "sqrt":
-            if a < 0:
+            if a < 0 or abs(a) < tol:  # a rounded value this close to 0 may be negative
                 raise SkipPointError
             v = mpmath.sqrt(a)
         elif name == "exp":
             v = mpmath.exp(a)
         elif name == "log":
-            if a <= 0:
+            if a <= tol:
                 raise SkipPointError
             v = mpmath.log(a)
         elif name in ("sin", "cos", "tan", "atan", "sinh", "cosh", "tanh"):
             v = getattr(mpmath, name)(a)
         elif name in ("asin", "acos"):
-            if abs(a) > 1:
+            # |a| this close to 1 may be above 1 exactly: asin(exp(1e-300)) is undefined,
+            # though exp(1e-300) rounds to 1 at any working precision
+            if abs(a) > 1 or abs(abs(a) - 1) < tol:
                 raise SkipPointError
             v = getattr(mpmath, name)(a)
         elif name == "abs":

@@ -79,6 +79,8 @@ _TWO_PI_LO = 2.0 * PI_LO
 BIG = 2.0**30
 #: Below this magnitude the odd functions are within one ulp of their argument.
 _SMALL = 2.0**-26
+#: atan(w) >= w (1 - w^2 / 3) >= w * _ATAN_TAIL for 0 <= w <= 2^-30
+_ATAN_TAIL = 1.0 - 2.0**-58
 # only used for estimates (an index off by one is caught by the rigorous checks)
 _TWO_OVER_PI = 2.0 / math.pi
 _INV_PI = 1.0 / math.pi
@@ -192,11 +194,14 @@ def _atan_enc(z):
     """Enclosure of atan(z) for any z, infinities included (atan(+-inf) = +-pi/2)."""
     if z == 0.0:
         return 0.0, 0.0
-    # |z| >= 2^30: atan(z) = +-pi/2 - atan(1/z) and atan(w) lies between w and 0
+    # |z| >= 2^30: atan(z) = +-pi/2 -+ atan(w) with w = 1/|z| <= 2^-30, and
+    # w (1 - 2^-58) <= w - w^3/3 <= atan(w) <= w
     if z >= BIG:
-        return sub_dn(PIO2_LO, div_up(1.0, z)), PIO2_HI
+        return (sub_dn(PIO2_LO, div_up(1.0, z)),
+                sub_up(PIO2_HI, mul_dn(div_dn(1.0, z), _ATAN_TAIL)))
     if z <= -BIG:
-        return -PIO2_HI, sub_up(-PIO2_LO, div_dn(1.0, z))
+        return (add_dn(-PIO2_HI, mul_dn(div_dn(1.0, -z), _ATAN_TAIL)),
+                sub_up(-PIO2_LO, div_dn(1.0, z)))
     if abs(z) < _SMALL:
         if z > 0.0:
             return next_down(z), z
