@@ -366,7 +366,7 @@ def test_plot_paving():
 
     sp = sivia(SQUARE, f=X**2 + Y**2, y=Interval([1], [4]), eps=0.2, keep_outside=True)
     fig, ax = plt.subplots()
-    colls = sp.plot(ax=ax)
+    colls = plot_paving(sp, ax=ax)
     assert [len(c.get_paths()) for c in colls] == [sp.outside.shape[0], len(sp.boundary()),
                                                    len(sp.inner())]
     with pytest.raises(ValueError, match="dims"):

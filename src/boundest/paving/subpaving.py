@@ -404,9 +404,3 @@ class Subpaving:
         i, j = pairs(so.lo, so.hi, oo.lo, oo.hi, strict=True)
         outside = Interval._new(np.maximum(so.lo[i], oo.lo[j]), np.minimum(so.hi[i], oo.hi[j]))
         return Subpaving(Interval._new(lo, hi), ins, outside)
-
-    def plot(self, ax: Any = None, dims: tuple[int, int] = (0, 1), **kw: Any) -> Any:
-        """Draw with matplotlib (``boundest.plot.plot_paving``)."""
-        from ..plot.paving import plot_paving
-
-        return plot_paving(self, ax=ax, dims=dims, **kw)

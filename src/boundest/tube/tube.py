@@ -548,12 +548,6 @@ class Tube:
     def __rtruediv__(self, other: Any) -> Tube:
         return self._rmap(lambda a, b: a / b, other)
 
-    def plot(self, ax: Any = None, **kwargs: Any) -> Any:
-        """Draw the tube (see :func:`boundest.plot.plot_tube`)."""
-        from ..plot.tube import plot_tube
-
-        return plot_tube(self, ax=ax, **kwargs)
-
 
 #: A tube vector is a ``Tube`` whose slices and gates have a trailing dimension.
 TubeVector = Tube
