@@ -4,19 +4,15 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 
 import numpy as np
 
 from . import __version__
-from .commands import RUNS, write_json
+from .commands import RUNS, pyplot, save_figure, write_json
 
 
 def _demo(args: argparse.Namespace) -> int:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     from .plot import plot_boxes
     from .scenarios import function_enclosure as fe
@@ -29,8 +25,6 @@ def _demo(args: argparse.Namespace) -> int:
     for r in result["enclosures"]:
         print(f"{r['pieces']:>6} [{r['range_lo']:>14.6f}, {r['range_hi']:>14.6f}] "
               f"{r['range_width']:>9.4f} {r['mean_box_height']:>16.5f}")
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), sharey=True)
     xs = np.linspace(*fe.DOMAIN, 2000)
     for ax, n in zip(axes, (16, 64), strict=True):
@@ -41,10 +35,7 @@ def _demo(args: argparse.Namespace) -> int:
         ax.set_xlabel("x")
         ax.legend(loc="upper left")
     axes[0].set_ylabel("f(x)")
-    fig.tight_layout()
-    png = out / "function_enclosure.png"
-    fig.savefig(png, dpi=120)
-    print(f"wrote {png}")
+    save_figure(fig, args.out, "function_enclosure")
     write_json(result, args.json)
     return 0
 

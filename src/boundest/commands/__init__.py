@@ -7,6 +7,29 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any
+
+
+def pyplot() -> Any:
+    """``matplotlib.pyplot`` on the Agg backend: figures are written to files, never shown."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def save_figure(fig: Any, out: str | Path, name: str, dpi: int = 120) -> Path:
+    """Lay out ``fig``, write it to ``out/name.png`` (creating the folder), close it, say so."""
+    folder = Path(out)
+    folder.mkdir(parents=True, exist_ok=True)
+    fig.tight_layout()
+    png = folder / f"{name}.png"
+    fig.savefig(png, dpi=dpi)
+    pyplot().close(fig)
+    print(f"wrote {png}")
+    return png
 
 
 def write_json(data: dict, path: str | None) -> None:

@@ -3,18 +3,14 @@
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
 import numpy as np
 
-from . import write_json
+from . import pyplot, save_figure, write_json
 
 
 def run(args: argparse.Namespace) -> int:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     from ..plot.scenarios_tube import plot_clock_distance, plot_clock_drift
     from ..scenarios import drifting_clock as dc
@@ -34,8 +30,6 @@ def run(args: argparse.Namespace) -> int:
             print(f"  tau_{i + 1} = {float(meas.tau.lo[i] + meas.tau.hi[i]) / 2:g}: "
                   f"[t_{i + 1}] = [{res.t.lo[i]:.3f}, {res.t.hi[i]:.3f}] (from [h] alone "
                   f"[{res.t_initial.lo[i]:.3f}, {res.t_initial.hi[i]:.3f}])")
-        out = Path(args.out)
-        out.mkdir(parents=True, exist_ok=True)
         truth = dc.ClockTruth() if args.data is None else None
         for name, fn, title in (
                 ("clock_distance", plot_clock_distance,
@@ -45,10 +39,7 @@ def run(args: argparse.Namespace) -> int:
             fig, ax = plt.subplots(figsize=(9, 5))
             fn(res, truth=truth, ax=ax)
             ax.set_title(title)
-            fig.tight_layout()
-            png = out / f"{name}.png"
-            fig.savefig(png, dpi=120)
-            print(f"wrote {png}")
+            save_figure(fig, args.out, name)
     write_json(res.to_json(), args.json)
     return 1 if res.empty else 0
 

@@ -3,17 +3,11 @@
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
-from . import write_json
+from . import pyplot, save_figure, write_json
 
 
 def run(args: argparse.Namespace) -> int:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     from ..plot import plot_set_sequence
     from ..scenarios import jaulin2001 as jw
 
@@ -34,16 +28,11 @@ def run(args: argparse.Namespace) -> int:
     empty = any(s["hull_lo"][0] is None for e in ("rcse", "ncse") for s in data[e]["sets"])
     if empty:
         print("proven INCONSISTENT: an empty set (the data contradict the model)")
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    pyplot()  # the file-only backend, before plot_set_sequence makes its figure
     fig = plot_set_sequence([res.rcse.x, res.ncse.x], ["causal (RCSE)", "non-causal (NCSE)"],
                             jw.FRAME)
     fig.suptitle("x(k), k = 0..10: causal and non-causal sets (seed 002, Fig. 7)", fontsize=10)
-    fig.tight_layout()
-    png = out / f"jaulin2001_{domains}.png"
-    fig.savefig(png, dpi=130)
-    plt.close(fig)
-    print(f"wrote {png}")
+    save_figure(fig, args.out, f"jaulin2001_{domains}", dpi=130)
     write_json(data, args.json)
     return 1 if empty else 0
 

@@ -3,18 +3,14 @@
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
 import numpy as np
 
-from . import write_json
+from . import pyplot, save_figure, write_json
 
 
 def run(args: argparse.Namespace) -> int:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     from ..plot.scenarios_tube import plot_range_only_diagonal, plot_range_only_map
     from ..scenarios import range_only as ro
@@ -41,23 +37,15 @@ def run(args: argparse.Namespace) -> int:
             print(f"  [t_{i + 1}] = [{res.t.lo[i]:.3f}, {res.t.hi[i]:.3f}] "
                   f"(data [{meas.t.lo[i]:.2f}, {meas.t.hi[i]:.2f}]), "
                   f"[z_{i + 1}] = [{res.z.lo[i]:.3f}, {res.z.hi[i]:.3f}]")
-        out = Path(args.out)
-        out.mkdir(parents=True, exist_ok=True)
         truth = ro.RobotTruth() if args.data is None else None
         fig, ax = plt.subplots(figsize=(9, 4))
         plot_range_only_diagonal(res, ax=ax)
         ax.set_title(f"position-box diagonal per iteration (seed 001, Fig. 8), dt = {args.dt:g}")
-        fig.tight_layout()
-        png = out / "range_only_diagonal.png"
-        fig.savefig(png, dpi=120)
-        print(f"wrote {png}")
+        save_figure(fig, args.out, "range_only_diagonal")
         fig, ax = plt.subplots(figsize=(9, 7))
         plot_range_only_map(res, truth=truth, ax=ax)
         ax.set_title("[x1](.) x [x2](.) among the beacons (seed 001, Fig. 9)")
-        fig.tight_layout()
-        png = out / "range_only_map.png"
-        fig.savefig(png, dpi=120)
-        print(f"wrote {png}")
+        save_figure(fig, args.out, "range_only_map")
     write_json(res.to_json(), args.json)
     return 1 if res.empty else 0
 

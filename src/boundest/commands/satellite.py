@@ -3,18 +3,14 @@
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
 import numpy as np
 
-from . import write_json
+from . import pyplot, save_figure, write_json
 
 
 def run(args: argparse.Namespace) -> int:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     from ..interval import Interval
     from ..plot import plot_boxes
@@ -43,8 +39,6 @@ def run(args: argparse.Namespace) -> int:
         w = res.x_hi - res.x_lo
         print("  mean width over k: " + ", ".join(f"x{i + 1} {np.mean(w[:, i]):.3f}"
                                                   for i in range(4)))
-        out = Path(args.out)
-        out.mkdir(parents=True, exist_ok=True)
         fig, ax = plt.subplots(figsize=(6.5, 6))
         plot_boxes(Interval._new(res.x_lo[:, 0], res.x_hi[:, 0]),
                    Interval._new(res.x_lo[:, 1], res.x_hi[:, 1]), ax=ax)
@@ -54,10 +48,7 @@ def run(args: argparse.Namespace) -> int:
         ax.set_aspect("equal")
         ax.set_title(f"[x1](k) x [x2](k), k = 0..{meas.k_max + 1} (seed 000, Fig. 4)")
         ax.legend()
-        fig.tight_layout()
-        png = out / f"satellite_k{meas.k_max}.png"
-        fig.savefig(png, dpi=120)
-        print(f"wrote {png}")
+        save_figure(fig, args.out, f"satellite_k{meas.k_max}")
     write_json(res.to_json(), args.json)
     return 0 if res.consistent else 1
 
