@@ -19,14 +19,13 @@ import json
 import os
 import platform
 import statistics
-import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 from _machine import cpu_model
+from _subprocess import run_json_script
 
 ROOT = Path(__file__).resolve().parent.parent
 CODAC1_PY = ROOT / ".bench-venv-codac1" / "bin" / "python"
@@ -68,14 +67,7 @@ def bench_codac1(eps: float, repeat: int) -> dict:
     y = jw.load()
     spec = {"y_lo": [float(v).hex() for v in y.lo[:, 0]],
             "y_hi": [float(v).hex() for v in y.hi[:, 0]], "eps": eps, "repeat": repeat}
-    with tempfile.NamedTemporaryFile("w", suffix=".json", delete=False) as fh:
-        json.dump(spec, fh)
-    try:
-        p = subprocess.run([str(CODAC1_PY), str(CODAC1_SCRIPT), fh.name], capture_output=True,
-                           text=True, timeout=600, check=True)
-    finally:
-        os.unlink(fh.name)
-    res = json.loads(p.stdout)
+    res = run_json_script(CODAC1_PY, CODAC1_SCRIPT, spec, timeout=600)
     hull = res.pop("hull")
     lo = np.array([[float.fromhex(v) for v in h["lo"]] for h in hull])
     hi = np.array([[float.fromhex(v) for v in h["hi"]] for h in hull])
@@ -91,7 +83,6 @@ def main() -> None:
     ap.add_argument("--no-codac", action="store_true")
     ap.add_argument("--out")
     args = ap.parse_args()
-    os.environ.setdefault("NUMBA_CACHE_DIR", "/tmp/numba-estimators")
     rows = []
     for e in (float(v) for v in args.eps.split(",")):
         print(f"boundest eps={e} ...", file=sys.stderr)

@@ -47,6 +47,7 @@ from typing import Any
 
 import numpy as np
 from _machine import cpu_model
+from _subprocess import run_json_script
 
 ROOT = Path(__file__).resolve().parent.parent
 CODAC_PY = ROOT / ".bench-venv-codac1" / "bin" / "python"
@@ -202,20 +203,7 @@ def _run_codac(python: Path, datasets: list[dict], args: argparse.Namespace,
         "ratio": args.codac_ratio,
         "fixpoint_ratio": args.codac_fixpoint_ratio,
     }
-    with tempfile.TemporaryDirectory() as tmp:
-        path = Path(tmp) / "satellite_codac_input.json"
-        path.write_text(json.dumps(spec))
-        t0 = time.perf_counter()
-        proc = subprocess.run([str(python), str(CODAC_SCRIPT), str(path)], capture_output=True,
-                              text=True, timeout=args.codac_timeout, check=False)
-        wall = time.perf_counter() - t0
-    sys.stderr.write(proc.stderr)
-    if proc.returncode != 0:
-        raise RuntimeError(f"satellite_codac.py exited with {proc.returncode}: "
-                           f"{proc.stderr.strip()[-2000:]}")
-    out = json.loads(proc.stdout)
-    out["subprocess_wall_s"] = wall
-    return out
+    return run_json_script(python, CODAC_SCRIPT, spec, args.codac_timeout)
 
 
 def _codac_row(rec: dict, ds: dict, b_res: Any, b_rec: dict, b_tight: dict | None) -> dict:

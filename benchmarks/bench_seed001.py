@@ -33,13 +33,13 @@ import platform
 import statistics
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from _machine import cpu_model
+from _subprocess import run_json_script
 
 ROOT = Path(__file__).resolve().parent.parent
 CODAC_PY = ROOT / ".bench-venv-codac1" / "bin" / "python"
@@ -143,23 +143,6 @@ def _codac_spec(ro: Any, dc: Any, dts: list[float], clock: list[dict],
               for row in clock]
     return {"cases": cases, "variants": args.codac_variants, "repeat": args.codac_repeat,
             "limit_s": float(args.codac_limit).hex()}
-
-
-def _run_codac(python: Path, spec: dict, timeout: float) -> dict:
-    with tempfile.TemporaryDirectory() as tmp:
-        path = Path(tmp) / "seed001_codac_input.json"
-        path.write_text(json.dumps(spec))
-        t0 = time.perf_counter()
-        proc = subprocess.run([str(python), str(CODAC_SCRIPT), str(path)], capture_output=True,
-                              text=True, timeout=timeout, check=False)
-        wall = time.perf_counter() - t0
-    sys.stderr.write(proc.stderr)
-    if proc.returncode != 0:
-        raise RuntimeError(f"seed001_codac.py exited with {proc.returncode}: "
-                           f"{proc.stderr.strip()[-2000:]}")
-    out = json.loads(proc.stdout)
-    out["subprocess_wall_s"] = wall
-    return out
 
 
 def _codac_robot_row(rec: dict, b_rec: dict, b_res: Any, ro: Any) -> dict:
@@ -288,8 +271,8 @@ def main() -> None:
         codac_info["skipped"] = f"{python} not found (see benchmarks/README.md)"
     else:
         try:
-            out = _run_codac(python, _codac_spec(ro, dc, dts, clock, args),
-                             args.codac_timeout)
+            out = run_json_script(python, CODAC_SCRIPT, _codac_spec(ro, dc, dts, clock, args),
+                                  args.codac_timeout)
             codac_info = {k: out[k] for k in ("codac_version", "python", "import_s",
                                               "fegetround_before_import",
                                               "fegetround_after_import", "subprocess_wall_s")}

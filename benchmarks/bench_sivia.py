@@ -40,13 +40,13 @@ import platform
 import statistics
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from _machine import cpu_model
+from _subprocess import run_json_script
 
 ROOT = Path(__file__).resolve().parent.parent
 CODAC_SCRIPT = Path(__file__).resolve().parent / "sivia_codac.py"
@@ -120,19 +120,10 @@ def _run_codac(which: str, cases: list[dict], repeat: int, long_s: float, timeou
                        "a": A.hex(), "b": B.hex(), "eps": float(c["eps"]).hex()}
                       for c in cases],
             "repeat": repeat, "long_s": long_s, "variants": variants}
-    with tempfile.TemporaryDirectory() as tmp:
-        path = Path(tmp) / "sivia_codac_input.json"
-        path.write_text(json.dumps(spec))
-        t0 = time.perf_counter()
-        proc = subprocess.run([str(python), str(CODAC_SCRIPT), str(path)], capture_output=True,
-                              text=True, timeout=timeout, check=False)
-        wall = time.perf_counter() - t0
-    sys.stderr.write(proc.stderr)
-    if proc.returncode != 0:
-        return {"skipped": f"sivia_codac.py exited with {proc.returncode}: "
-                           f"{proc.stderr.strip()[-1500:]}"}
-    out = json.loads(proc.stdout)
-    out["subprocess_wall_s"] = wall
+    try:
+        out = run_json_script(python, CODAC_SCRIPT, spec, timeout)
+    except RuntimeError as exc:
+        return {"skipped": str(exc)[-1500:]}
     for r in out["results"]:
         r["eps"] = float.fromhex(r["eps"])
         if "processed" in r:

@@ -30,7 +30,6 @@ import json
 import os
 import platform
 import statistics
-import subprocess
 import sys
 import tempfile
 import time
@@ -39,6 +38,7 @@ from typing import Any
 
 import numpy as np
 from _machine import cpu_model
+from _subprocess import run_json_script
 
 import boundest.interval as iv
 from boundest import Interval
@@ -104,14 +104,11 @@ def bench_codac(sizes: list[int], repeat: int) -> dict[str, Any] | None:
                 np.ascontiguousarray(arr, dtype=np.float64).tofile(path)
                 files[key] = path
             cases.append({"n": n, **files})
-        spec = os.path.join(tmp, "spec.json")
-        Path(spec).write_text(json.dumps({"cases": cases, "repeat": repeat}))
-        proc = subprocess.run([str(CODAC_PY), str(CODAC_SCRIPT), spec], capture_output=True,
-                              text=True, check=False)
-    if proc.returncode != 0:
-        print(f"codac run failed:\n{proc.stderr}", file=sys.stderr)
-        return None
-    out = json.loads(proc.stdout)
+        try:
+            out = run_json_script(CODAC_PY, CODAC_SCRIPT, {"cases": cases, "repeat": repeat})
+        except RuntimeError as exc:
+            print(f"codac run failed: {exc}", file=sys.stderr)
+            return None
     for row in out["cases"]:
         for k, val in list(row.items()):
             if isinstance(val, str):

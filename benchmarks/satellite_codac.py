@@ -33,21 +33,12 @@ Usage (normally through bench_satellite.py)::
 
 from __future__ import annotations
 
-import ctypes
-import ctypes.util
 import json
 import statistics
 import sys
 import time
 
-
-def _fegetround() -> int | None:
-    try:
-        libm = ctypes.CDLL(ctypes.util.find_library("m"))
-        return int(libm.fegetround())
-    except (OSError, AttributeError, TypeError):
-        return None
-
+from _subprocess import fegetround
 
 FUNCTION_ARGS = ("x1", "x2", "x3", "x4", "w1", "w2", "w3", "w4", "y1", "y2", "y3",
                  "n1", "n2", "n3", "n4")
@@ -72,12 +63,12 @@ def main() -> None:
     ratio = spec.get("ratio")
     fix_ratio = float(spec["fixpoint_ratio"])
 
-    mode_before = _fegetround()
+    mode_before = fegetround()
     t0 = time.perf_counter()
     import codac
     from codac import ContractorNetwork, CtcFixPoint, CtcFunction, Function, Interval, oo
     import_s = time.perf_counter() - t0
-    mode_after = _fegetround()
+    mode_after = fegetround()
 
     def contractor(variant: str):
         f = Function(*FUNCTION_ARGS, FUNCTION_EXPR)

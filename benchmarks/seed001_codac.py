@@ -53,21 +53,13 @@ Usage (normally through bench_seed001.py)::
 
 from __future__ import annotations
 
-import ctypes
-import ctypes.util
 import json
 import math
 import statistics
 import sys
 import time
 
-
-def _fegetround() -> int | None:
-    try:
-        libm = ctypes.CDLL(ctypes.util.find_library("m"))
-        return int(libm.fegetround())
-    except (OSError, AttributeError, TypeError):
-        return None
+from _subprocess import fegetround
 
 
 def _h(v: float) -> str:
@@ -88,7 +80,7 @@ def _decode(obj):
 def main() -> None:
     with open(sys.argv[1]) as fh:
         spec = _decode(json.load(fh))      # decoded under round-to-nearest, before codac
-    mode_before = _fegetround()
+    mode_before = fegetround()
     t0 = time.perf_counter()
     from codac import (
         ContractorNetwork,
@@ -103,7 +95,7 @@ def main() -> None:
         TubeVector,
     )
     import_s = time.perf_counter() - t0
-    mode_after = _fegetround()
+    mode_after = fegetround()
 
     def gate_times(tube, every: int) -> tuple[list, list]:
         """Indices and times of every ``every``-th gate, and of the last one.
