@@ -28,51 +28,38 @@ def _dur_dn(a: float, b: float) -> float:
 
 
 @_njit
+def _walk_dn(t: NDArray, v: NDArray, a: float, b: float, forward: bool
+             ) -> tuple[float, float]:
+    """Lower bounds of the integral over ``[a, b]`` of the piecewise constant ``f`` worth
+    ``v[i]`` on ``[t[i], t[i+1]]``, summed slice by slice from ``a`` (``forward``) or from
+    ``b``: ``(total, minimum of the partial sums at the breakpoints, 0 included)``."""
+    n = v.size
+    total = least = 0.0
+    if forward:
+        i, step = np.searchsorted(t, a, side="right") - 1, 1
+    else:
+        i, step = np.searchsorted(t, b, side="left") - 1, -1
+    i = min(max(i, 0), n - 1)
+    while 0 <= i < n and t[i] < b and t[i + 1] > a:
+        lo, hi = max(t[i], a), min(t[i + 1], b)
+        if hi > lo:
+            d_dn, d_up = _dur_dn(lo, hi), sub_up(hi, lo)
+            total = add_dn(total, min(mul_dn(v[i], d_dn), mul_dn(v[i], d_up)))
+            least = min(least, total)
+        i += step
+    return total, least
+
+
+@_njit
 def _low_integral(t: NDArray, v: NDArray, a0: float, a1: float, b0: float, b1: float) -> float:
     """Lower bound of ``min over s in [a0, a1], u in [b0, b1] of ∫_s^u f`` for the piecewise
     constant ``f`` worth ``v[i]`` on ``[t[i], t[i+1]]`` (``a1 <= b0``, all inside the grid).
 
     ``∫_s^u f = ∫_s^{a1} f + ∫_{a1}^{b0} f + ∫_{b0}^u f``: the first and last terms are
     piecewise linear in ``s`` and ``u``, so their minima are at the gates or the ends."""
-    n = v.size
-    # middle part [a1, b0]
-    mid = 0.0
-    i = np.searchsorted(t, a1, side="right") - 1
-    i = min(max(i, 0), n - 1)
-    while i < n and t[i] < b0:
-        lo = max(t[i], a1)
-        hi = min(t[i + 1], b0)
-        if hi > lo:
-            d_dn, d_up = _dur_dn(lo, hi), sub_up(hi, lo)
-            term = min(mul_dn(v[i], d_dn), mul_dn(v[i], d_up))
-            mid = add_dn(mid, term)
-        i += 1
-    # backward from a1 to a0: partial sums of ∫_s^{a1}, minimum over breakpoints (and 0)
-    first = 0.0
-    acc = 0.0
-    i = np.searchsorted(t, a1, side="left") - 1
-    i = min(max(i, 0), n - 1)
-    while i >= 0 and t[i + 1] > a0:
-        lo = max(t[i], a0)
-        hi = min(t[i + 1], a1)
-        if hi > lo:
-            d_dn, d_up = _dur_dn(lo, hi), sub_up(hi, lo)
-            acc = add_dn(acc, min(mul_dn(v[i], d_dn), mul_dn(v[i], d_up)))
-            first = min(first, acc)
-        i -= 1
-    # forward from b0 to b1
-    last = 0.0
-    acc = 0.0
-    i = np.searchsorted(t, b0, side="right") - 1
-    i = min(max(i, 0), n - 1)
-    while i < n and t[i] < b1:
-        lo = max(t[i], b0)
-        hi = min(t[i + 1], b1)
-        if hi > lo:
-            d_dn, d_up = _dur_dn(lo, hi), sub_up(hi, lo)
-            acc = add_dn(acc, min(mul_dn(v[i], d_dn), mul_dn(v[i], d_up)))
-            last = min(last, acc)
-        i += 1
+    mid = _walk_dn(t, v, a1, b0, True)[0]
+    first = _walk_dn(t, v, a0, a1, False)[1]  # ∫_s^{a1}, s walking back from a1
+    last = _walk_dn(t, v, b0, b1, True)[1]
     r = add_dn(add_dn(first, mid), last)
     return -INF if r != r else r
 
