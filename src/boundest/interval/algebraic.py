@@ -79,9 +79,9 @@ _bmin = min
 _bmax = max
 _bany = any
 
-_jit = nb.njit(inline="always", cache=True)
+_jit = nb.njit(inline="always", cache=True, error_model="numpy")
 #: Larger helpers (loops) are compiled once and called, not inlined everywhere.
-_jit_call = nb.njit(cache=True)
+_jit_call = nb.njit(cache=True, error_model="numpy")
 
 ETA = 2.0**-1074
 #: Bound on the relative error of one double-word product (< 8 u^2) or reciprocal (< 11 u^2).

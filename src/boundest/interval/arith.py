@@ -28,7 +28,7 @@ from .rounding import (
 __all__ = ["add", "div", "mul", "neg", "recip", "sqr", "sqrt", "sub"]
 
 IntervalLike = ArrayLike | Interval
-_njit = nb.njit(cache=True)
+_njit = nb.njit(cache=True, error_model="numpy")
 
 
 # One branch-free scalar kernel per bound (selects, no jumps), so that Numba's ufunc loops

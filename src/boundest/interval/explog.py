@@ -106,9 +106,9 @@ _POW10 = np.array([float(10**k) for k in range(23)])
 _LIBM_REL = (LIBM_ULPS + 1) * 2.0**-52
 _LIBM_ABS = LIBM_ULPS * ETA
 
-_jit = nb.njit(inline="always", cache=True)
+_jit = nb.njit(inline="always", cache=True, error_model="numpy")
 #: Larger helpers called from several kernels: compiled once (LLVM still inlines them).
-_fn = nb.njit(cache=True)
+_fn = nb.njit(cache=True, error_model="numpy")
 
 
 # =============================================================================================

@@ -59,7 +59,7 @@ LIBM_ULPS = 4
 _LIBM_REL = (LIBM_ULPS + 1) * 2.0**-52
 _LIBM_ABS = LIBM_ULPS * ETA
 
-_jit = nb.njit(cache=True)  # small helpers: LLVM inlines them, Numba compiles them once
+_jit = nb.njit(cache=True, error_model="numpy")  # small helpers: LLVM inlines them
 
 
 @intrinsic

@@ -90,10 +90,10 @@ _EST_ABS = 2.0**-1000
 # floats, not ints: Numba would compile one specialisation per integer literal
 _SIN, _COS, _TAN = 0.0, 1.0, 2.0
 
-_jit = nb.njit(inline="always", cache=True)
+_jit = nb.njit(inline="always", cache=True, error_model="numpy")
 #: Larger helpers: LLVM still inlines them into the kernels, while Numba-IR inlining
 #: (inline='always') at every call site multiplies the compile time (minutes).
-_njit = nb.njit(cache=True)
+_njit = nb.njit(cache=True, error_model="numpy")
 
 
 # ---------------------------------------------------------------------------------------------

@@ -29,7 +29,7 @@ from .tube import Tube
 
 __all__ = ["CtcDeriv", "deriv_kernel"]
 
-_njit = nb.njit(cache=True)
+_njit = nb.njit(cache=True, error_model="numpy")
 
 
 @_njit

@@ -36,7 +36,7 @@ from .tube import Tube
 
 __all__ = ["CtcEval", "eval_kernel"]
 
-_njit = nb.njit(cache=True)
+_njit = nb.njit(cache=True, error_model="numpy")
 
 
 @_njit

@@ -17,7 +17,7 @@ from ..interval.rounding import INF, add_dn, add_up, mul_dn, mul_up, sub_dn, sub
 
 __all__ = ["integral_bounds", "primitive_gates"]
 
-_njit = nb.njit(cache=True)
+_njit = nb.njit(cache=True, error_model="numpy")
 
 
 @_njit
