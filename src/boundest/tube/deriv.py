@@ -131,8 +131,14 @@ class CtcDeriv:
     """Contractor for ``x'(.) = v(.)`` on tubes (or tube vectors) on the same gate times.
 
     ``contract(x, v)`` contracts ``x`` in place (forward and backward in time, tight at the
-    gates, slices by the polygon envelope of the two cones); ``v`` is left unchanged (seed 001
-    Lemma 3: nothing can be learnt on the derivative). Returns ``x``.
+    gates, slices by the polygon envelope of the two cones); ``v`` is left unchanged (Rohou et
+    al. 2018, Lemma 3: nothing can be learnt on the derivative). Returns ``x``.
+
+    Only the slices of ``v`` are read: ``v`` may jump at every gate (a tube with
+    ``continuous=False``, e.g. :meth:`Tube.piecewise_constant` of held sensor boxes), since
+    ``x(t_{i+1}) - x(t_i)`` is the integral of ``v`` over the open slice. ``x`` has a
+    derivative, so it is continuous: a tube ``x`` with jumps is made continuous first
+    (:meth:`Tube.make_continuous`).
 
     Examples
     --------
@@ -154,6 +160,7 @@ class CtcDeriv:
         if x.is_empty() or v.is_empty():
             x.set_empty()
             return x
+        x.continuous = True  # the kernel's first step puts the gates inside both slices
         ok = deriv_kernel(x.t, _as2d(x.slices.lo), _as2d(x.slices.hi), _as2d(x.gates.lo),
                           _as2d(x.gates.hi), _as2d(v.slices.lo), _as2d(v.slices.hi))
         if not ok:

@@ -205,6 +205,10 @@ class CtcEval:
     constraint holds componentwise at the same time ``t``. When the measurement cannot be met,
     ``t``, ``z`` and ``y`` all become empty.
 
+    Only the slices of ``w`` are read: the derivative may jump at every gate (a tube with
+    ``continuous=False``). ``y`` has a derivative, so a tube ``y`` with jumps is made
+    continuous first (:meth:`Tube.make_continuous`).
+
     Examples
     --------
     >>> y = Tube.constant(0, 10, 100, Interval(-10, 10))
@@ -224,6 +228,7 @@ class CtcEval:
                              f"{y.slices.shape[1:]}")
         if not np.array_equal(y.t, w.t) or y.slices.shape != w.slices.shape:
             raise ValueError("CtcEval: y and w must share their gate times and dimension")
+        y.make_continuous()
         t0, tf = y.domain
         ok = not (t.is_empty() or np.any(z.is_empty()) or y.is_empty() or w.is_empty())
         tl, th = (max(float(t.lo), t0), min(float(t.hi), tf)) if ok else (1.0, 0.0)

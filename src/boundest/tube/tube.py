@@ -1,11 +1,23 @@
 """Sliced tubes: enclosures of trajectories over a time grid, held as interval arrays.
 
 A tube over ``[t0, tf]`` has gate times ``t[0] < ... < t[n]``, one slice enclosure per time
-interval ``[t[i], t[i+1]]`` and one gate enclosure per gate time. A trajectory ``x(.)`` belongs
-to the tube when ``x(s) ∈ slices[i]`` for every ``s`` in ``[t[i], t[i+1]]`` and
-``x(t[i]) ∈ gates[i]``. A tube vector is the same with a trailing dimension ``d``
-(``slices`` of shape ``(n, d)``). A tube with one empty slice or gate is empty as a whole (no
-trajectory can cross it); every operation keeps it wholly empty (all bounds NaN).
+interval ``[t[i], t[i+1]]`` and one gate enclosure per gate time. A tube vector is the same with
+a trailing dimension ``d`` (``slices`` of shape ``(n, d)``).
+
+Two kinds of tube say what a slice encloses:
+
+- **continuous** (the default): a trajectory ``x(.)`` belongs to the tube when
+  ``x(s) ∈ slices[i]`` for every ``s`` in the *closed* ``[t[i], t[i+1]]`` and
+  ``x(t[i]) ∈ gates[i]``, so a gate lies in both neighbouring slices. This holds for every
+  continuous trajectory (states, anything with a derivative).
+- **with jumps** (``continuous=False``): ``x(s) ∈ slices[i]`` on the *open* ``]t[i], t[i+1][``
+  only, and the gates are independent values: neighbouring slices need not overlap. This is
+  the tube of a piecewise-continuous signal: a derivative, a bang-bang input, sensor boxes held
+  over each sample (:meth:`Tube.piecewise_constant`). Its default gates are the hull of the
+  neighbouring slices (the value at a jump is the left or the right one).
+
+A tube with one empty slice or gate is empty as a whole (no trajectory can cross it); every
+operation keeps it wholly empty (all bounds NaN).
 """
 
 from __future__ import annotations
@@ -72,7 +84,13 @@ class Tube:
         Enclosure over each slice ``[t[i], t[i+1]]``.
     gates : Interval, shape (n+1,) or (n+1, d), optional
         Enclosure at each gate time; default: the intersection of the neighbouring slices
-        (a continuous trajectory's value at a gate lies in both).
+        (a continuous trajectory's value at a gate lies in both), or their hull for a tube with
+        jumps.
+    continuous : bool
+        ``True`` (default): the trajectories are continuous, each slice encloses them over its
+        closed time interval, and two neighbouring slices must overlap (else ``ValueError``:
+        no continuous trajectory crosses their gate). ``False``: the trajectories may jump at
+        the gates (see the module docstring); the slices enclose them on open time intervals.
 
     Examples
     --------
@@ -83,30 +101,36 @@ class Tube:
     Interval([-1.0, 1.0])
     """
 
-    __slots__ = ("gates", "slices", "t")
+    __slots__ = ("continuous", "gates", "slices", "t")
     __array_ufunc__ = None
     __hash__ = None  # type: ignore[assignment]
 
     t: NDArray[np.float64]
     slices: Interval
     gates: Interval
+    continuous: bool
 
-    def __init__(self, t: ArrayLike, slices: Interval, gates: Interval | None = None) -> None:
+    def __init__(self, t: ArrayLike, slices: Interval, gates: Interval | None = None,
+                 continuous: bool = True) -> None:
         t = _check_times(t)
         slices = as_interval(slices)
         n = t.size - 1
         if slices.ndim not in (1, 2) or slices.shape[0] != n:
             raise ValueError(f"slices must have shape ({n},) or ({n}, d) for {n + 1} gate "
                              f"times, got {slices.shape}")
+        if continuous:
+            _check_overlap(t, slices)
         if gates is None:
-            gates = _default_gates(slices)
+            gates = _default_gates(slices) if continuous else _hull_gates(slices)
         else:
             gates = as_interval(gates)
             if gates.shape != (n + 1, *slices.shape[1:]):
                 raise ValueError(f"gates must have shape {(n + 1, *slices.shape[1:])}, got "
                                  f"{gates.shape}")
-            gates = intersect(gates, _default_gates(slices))
+            if continuous:
+                gates = intersect(gates, _default_gates(slices))
         self.t = t
+        self.continuous = bool(continuous)
         self.slices = Interval._new(np.array(slices.lo, dtype=np.float64),
                                     np.array(slices.hi, dtype=np.float64))
         self.gates = Interval._new(np.array(gates.lo, dtype=np.float64),
@@ -114,10 +138,11 @@ class Tube:
         self._normalize_empty()
 
     @classmethod
-    def _wrap(cls, t: NDArray, slices: Interval, gates: Interval) -> Tube:
+    def _wrap(cls, t: NDArray, slices: Interval, gates: Interval,
+              continuous: bool = True) -> Tube:
         """Wrap arrays without checks or copies (they must satisfy the invariants)."""
         obj = object.__new__(cls)
-        obj.t, obj.slices, obj.gates = t, slices, gates
+        obj.t, obj.slices, obj.gates, obj.continuous = t, slices, gates, continuous
         return obj
 
     # -- constructors -----------------------------------------------------------------------
@@ -136,6 +161,31 @@ class Tube:
         gates = Interval._new(np.broadcast_to(v.lo, (n + 1, *v.shape)).copy(),
                               np.broadcast_to(v.hi, (n + 1, *v.shape)).copy())
         return cls._wrap(t, slices, gates)._normalize_empty()
+
+    @classmethod
+    def piecewise_constant(cls, t: ArrayLike, values: Interval | ArrayLike,
+                           gates: Interval | None = None) -> Tube:
+        """A tube with jumps from per-slice boxes: the signal lies in ``values[i]`` on
+        ``]t[i], t[i+1][`` and may jump at every gate (sampled data held over each sample, a
+        piecewise-constant or bang-bang input, the derivative of a state).
+
+        Parameters
+        ----------
+        t : array_like, shape (n+1,)
+            Gate times, strictly increasing (for held samples: the sample times and the end).
+        values : Interval or array_like, shape (n,) or (n, d)
+            The box of each slice (an array gives degenerate boxes). Neighbouring boxes need
+            not overlap.
+        gates : Interval, shape (n+1,) or (n+1, d), optional
+            The values at the gate times; default: the hull of the neighbouring slices.
+
+        Examples
+        --------
+        >>> v = Tube.piecewise_constant([0, 1, 2], Interval([1, -1], [1, -1]))
+        >>> v.continuous, v(0.5), v(1.5), v(1.0)
+        (False, Interval([1.0, 1.0]), Interval([-1.0, -1.0]), Interval([-1.0, 1.0]))
+        """
+        return cls(t, as_interval(values), gates, continuous=False)
 
     @classmethod
     def from_function(cls, t0: float, tf: float, dt_or_n: float | int,
@@ -214,18 +264,29 @@ class Tube:
     def __repr__(self) -> str:
         kind = f"TubeVector(dim={self.dim}, " if self.is_vector else "Tube("
         t0, tf = self.domain
+        jumps = "" if self.continuous else ", continuous=False"
         return (f"{kind}domain=[{t0!r}, {tf!r}], slices={self.n_slices}, "
-                f"max_thickness={self.max_thickness()!r})")
+                f"max_thickness={self.max_thickness()!r}{jumps})")
 
     def copy(self) -> Tube:
-        return Tube._wrap(self.t.copy(), self.slices.copy(), self.gates.copy())
+        return Tube._wrap(self.t.copy(), self.slices.copy(), self.gates.copy(), self.continuous)
 
     def __getitem__(self, i: int) -> Tube:
         """Component ``i`` of a tube vector, as a scalar tube sharing its storage (a view:
         contracting it contracts the vector)."""
         if not self.is_vector:
             raise TypeError("only a tube vector has components")
-        return Tube._wrap(self.t, self.slices[:, i], self.gates[:, i])
+        return Tube._wrap(self.t, self.slices[:, i], self.gates[:, i], self.continuous)
+
+    def make_continuous(self) -> Tube:
+        """Declare the trajectories continuous (a constraint such as ``x' = v`` proves it):
+        the gates are intersected with both neighbouring slices, in place. Returns ``self``."""
+        if not self.continuous:
+            self.continuous = True
+            g = intersect(self.gates, _default_gates(self.slices))
+            self.gates.lo[...], self.gates.hi[...] = g.lo, g.hi
+            self._normalize_empty()
+        return self
 
     @staticmethod
     def stack(tubes: list[Tube]) -> Tube:
@@ -240,7 +301,8 @@ class Tube:
                           np.stack([y.slices.hi for y in tubes], axis=1))
         g = Interval._new(np.stack([y.gates.lo for y in tubes], axis=1),
                           np.stack([y.gates.hi for y in tubes], axis=1))
-        return Tube._wrap(t.copy(), s, g)._normalize_empty()
+        cont = all(y.continuous for y in tubes)
+        return Tube._wrap(t.copy(), s, g, cont)._normalize_empty()
 
     # -- emptiness -----------------------------------------------------------------------------
     def is_empty(self) -> bool:
@@ -325,16 +387,18 @@ class Tube:
 
     def contains(self, t_samples: ArrayLike, y_samples: ArrayLike) -> bool:
         """Whether the sampled trajectory ``y(t_k)`` lies in the tube at every sample (a sample at
-        a gate time is checked against the gate and both neighbouring slices)."""
+        a gate time is checked against the gate, and for a continuous tube also against both
+        neighbouring slices)."""
         s = np.asarray(t_samples, dtype=np.float64).ravel()
         y = np.asarray(y_samples, dtype=np.float64).reshape(s.size, *self.slices.shape[1:])
         self._check_in_domain(s, s)
         if self.is_empty():
             return False
         ok = self._eval_points(s).contains(y)
-        i = np.clip(np.searchsorted(self.t, s, side="right") - 1, 0, self.n_slices - 1)
-        j = np.clip(np.searchsorted(self.t, s, side="left") - 1, 0, self.n_slices - 1)
-        ok &= self.slices[i].contains(y) & self.slices[j].contains(y)
+        if self.continuous:
+            i = np.clip(np.searchsorted(self.t, s, side="right") - 1, 0, self.n_slices - 1)
+            j = np.clip(np.searchsorted(self.t, s, side="left") - 1, 0, self.n_slices - 1)
+            ok &= self.slices[i].contains(y) & self.slices[j].contains(y)
         return bool(np.all(ok))
 
     def inverse(self, z: Interval | ArrayLike, hull: bool = False,
@@ -431,6 +495,7 @@ class Tube:
                                 float(x0.hi[j])) for j in range(d)]
         glo, ghi, slo, shi = (np.concatenate([c[k] for c in cols], axis=1) for k in range(4))
         shape = self.slices.shape[1:]
+        # a primitive is continuous whether or not the integrand jumps
         out = Tube._wrap(self.t.copy(), Interval._new(slo.reshape(n, *shape),
                                                       shi.reshape(n, *shape)),
                          Interval._new(glo.reshape(n + 1, *shape), ghi.reshape(n + 1, *shape)))
@@ -459,22 +524,27 @@ class Tube:
             raise ValueError("tubes must share their gate times")
 
     def __and__(self, other: Tube | Interval | ArrayLike) -> Tube:
-        """Intersection (slice- and gate-wise)."""
+        """Intersection (slice- and gate-wise). It is continuous when either tube is: its
+        trajectories belong to both."""
         if isinstance(other, Tube):
             self._check_grid(other)
-            return Tube._wrap(self.t, intersect(self.slices, other.slices),
-                              intersect(self.gates, other.gates))._normalize_empty()
-        return Tube._wrap(self.t, intersect(self.slices, other),
-                          intersect(self.gates, other))._normalize_empty()
+            out = Tube._wrap(self.t, intersect(self.slices, other.slices),
+                             intersect(self.gates, other.gates), self.continuous)
+            if other.continuous and not self.continuous:
+                out.make_continuous()
+            return out._normalize_empty()
+        return Tube._wrap(self.t, intersect(self.slices, other), intersect(self.gates, other),
+                          self.continuous)._normalize_empty()
 
     def __or__(self, other: Tube) -> Tube:
-        """Hull (slice- and gate-wise)."""
+        """Hull (slice- and gate-wise); continuous when both tubes are."""
         self._check_grid(other)
         if self.is_empty():
             return other.copy()
         if other.is_empty():
             return self.copy()
-        return Tube._wrap(self.t, hull(self.slices, other.slices), hull(self.gates, other.gates))
+        return Tube._wrap(self.t, hull(self.slices, other.slices), hull(self.gates, other.gates),
+                          self.continuous and other.continuous)
 
     def is_subset(self, other: Tube) -> bool:
         self._check_grid(other)
@@ -497,24 +567,29 @@ class Tube:
             gates[0] = self.slices[i0]
         if self.t[i1] != tf:
             gates[-1] = self.slices[i1 - 1]
-        return Tube._wrap(t, slices, gates)
+        return Tube._wrap(t, slices, gates, self.continuous)
 
     # -- arithmetic --------------------------------------------------------------------------------
     def map(self, f: Callable[..., Interval], *others: Tube | Interval | ArrayLike) -> Tube:
         """The tube ``f(self, *others)`` of an interval function applied to all slices and gates
-        at once (others: tubes on the same grid, or intervals broadcast over time)."""
+        at once (others: tubes on the same grid, or intervals broadcast over time). The result
+        is continuous (each slice encloses it over its closed time interval) when every tube
+        argument is, whatever ``f``: ``f`` of closed-slice enclosures encloses the values there.
+        """
         s_args, g_args = [self.slices], [self.gates]
+        cont = self.continuous
         for o in others:
             if isinstance(o, Tube):
                 self._check_grid(o)
                 s_args.append(o.slices)
                 g_args.append(o.gates)
+                cont = cont and o.continuous
             else:
                 s_args.append(as_interval(o))
                 g_args.append(as_interval(o))
-        out = Tube._wrap(self.t, as_interval(f(*s_args)), as_interval(f(*g_args)))
+        out = Tube._wrap(self.t, as_interval(f(*s_args)), as_interval(f(*g_args)), cont)
         if self.is_empty() or any(isinstance(o, Tube) and o.is_empty() for o in others):
-            out = Tube._wrap(self.t, out.slices.copy(), out.gates.copy())
+            out = Tube._wrap(self.t, out.slices.copy(), out.gates.copy(), cont)
             out.set_empty()
         return out._normalize_empty()
 
@@ -567,3 +642,28 @@ def _default_gates(slices: Interval) -> Interval:
     inner = intersect(slices[:-1], slices[1:])
     return Interval._new(np.concatenate([first.lo, inner.lo, last.lo]),
                          np.concatenate([first.hi, inner.hi, last.hi]))
+
+
+def _hull_gates(slices: Interval) -> Interval:
+    """Gates of a tube with jumps: the hull of the neighbouring slices."""
+    first, last = slices[:1], slices[-1:]
+    inner = hull(slices[:-1], slices[1:])
+    return Interval._new(np.concatenate([first.lo, inner.lo, last.lo]),
+                         np.concatenate([first.hi, inner.hi, last.hi]))
+
+
+def _check_overlap(t: NDArray, slices: Interval) -> None:
+    """Reject non-empty neighbouring slices that do not overlap in a continuous tube."""
+    lo = slices.lo.reshape(slices.shape[0], -1)
+    hi = slices.hi.reshape(slices.shape[0], -1)
+    with np.errstate(invalid="ignore"):
+        gap = (np.maximum(lo[:-1], lo[1:]) > np.minimum(hi[:-1], hi[1:]))
+    if gap.any():
+        i, j = (int(k) for k in np.argwhere(gap)[0])
+        comp = f" (component {j})" if slices.ndim == 2 else ""
+        a, b = (float(v) for v in (lo[i, j], hi[i, j]))
+        c, d = (float(v) for v in (lo[i + 1, j], hi[i + 1, j]))
+        raise ValueError(
+            f"slices {i} [{a!r}, {b!r}] and {i + 1} [{c!r}, {d!r}]{comp} do not overlap: no "
+            f"continuous trajectory crosses the gate t = {float(t[i + 1])!r}; for a signal that "
+            f"jumps (a derivative, held samples) use Tube.piecewise_constant or continuous=False")
