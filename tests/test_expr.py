@@ -814,6 +814,8 @@ def test_integer_exponent_beyond_2_53_is_refused():
         with pytest.raises(ValueError, match="integer exponent"):
             bd.pow(x, n)
     assert (x ** 2**53).param == 2**53
+    with pytest.raises(TypeError, match="boolean"):
+        _ = x**True
     with pytest.raises(ValueError, match="pown needs an integer"):
         from boundest.expr import functions
         functions.pown(x, 2.5)
@@ -826,6 +828,21 @@ def test_integer_exponent_beyond_2_53_is_refused():
 #: A literal must parse in far less than this; the bound guards against hangs (an exact
 #: rational of 10**9 digits), not performance.
 HANG_GUARD_S = 0.05
+
+
+def timed(f, *args):
+    """``(f(*args), seconds)``, the best of up to 3 runs: a run slowed down by a busy machine is
+    retried, a hang is not (it never returns)."""
+    import time
+
+    best = math.inf
+    for _ in range(3):
+        t0 = time.perf_counter()
+        out = f(*args)
+        best = min(best, time.perf_counter() - t0)
+        if best < HANG_GUARD_S:
+            break
+    return out, best
 
 _LIT = re.compile(r"([+-]?)([0-9]*)(?:\.([0-9]*))?(?:[eE]([+-]?[0-9]+))?")
 
@@ -904,17 +921,14 @@ def near_float_literals(draw):
 @settings(max_examples=600)
 @given(st.one_of(literals(), near_float_literals()))
 def test_any_literal_is_enclosed_exactly_and_quickly(text):
-    import time
-
-    t0 = time.perf_counter()
-    iv = decimal_interval(text)
-    assert time.perf_counter() - t0 < HANG_GUARD_S  # hang guard (see HANG_GUARD_S)
+    iv, seconds = timed(decimal_interval, text)
+    assert seconds < HANG_GUARD_S  # hang guard (see HANG_GUARD_S)
     reference_check(text, iv)
     # the same literal in a model file (the sign is the unary minus of the grammar)
     body = text.lstrip("+-")
-    t0 = time.perf_counter()
-    m = parse_model(f"x in [-oo, +oo]; Constraints x = {'-' if text[0] == '-' else ''}{body};")
-    assert time.perf_counter() - t0 < HANG_GUARD_S
+    m, seconds = timed(parse_model, f"x in [-oo, +oo]; Constraints x = "
+                                    f"{'-' if text[0] == '-' else ''}{body};")
+    assert seconds < HANG_GUARD_S
     c = m.constraints[0].rhs
     assert isinstance(c, Const)
     assert (float(c.value.lo), float(c.value.hi)) == (float(iv.lo), float(iv.hi))
@@ -935,13 +949,10 @@ def test_any_literal_is_enclosed_exactly_and_quickly(text):
     ("0e999999999999999999999999", 0.0, 0.0),
 ])
 def test_huge_literals_parse_at_once(text, lo, hi):
-    import time
-
-    t0 = time.perf_counter()
-    m = parse_model(f"x in [-oo, +oo];\nConstraints\nx = {text.lstrip('-')};")
+    m, seconds = timed(parse_model, f"x in [-oo, +oo];\nConstraints\nx = {text.lstrip('-')};")
     # hang guard, not a performance test: a 1 MB literal takes a few ms to tokenise; the
     # exact rational of 1e999999999 would take forever, 1e-10000000 ~20 s
-    assert time.perf_counter() - t0 < 1.0
+    assert seconds < 1.0
     iv = decimal_interval(text)
     if lo == hi == 0.1:
         lo = float(np.nextafter(0.1, 0))  # 0.1's enclosure

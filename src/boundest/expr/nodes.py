@@ -92,6 +92,7 @@ class Expr:
         return self
 
     def __pow__(self, o: object) -> Expr:
+        """``self ** o``: the integer power for an integer constant ``o`` (see ``power``)."""
         return power(self, o)
 
     def __rpow__(self, o: object) -> Expr:
@@ -312,7 +313,11 @@ def power(base: object, exponent: object) -> Expr:
     ValueError
         For an integer-valued exponent beyond ``MAX_POWN_EXPONENT`` (not representable exactly
         in a tape; ``pow`` would silently drop the negative bases).
+    TypeError
+        For a boolean exponent.
     """
+    if isinstance(exponent, bool):
+        raise TypeError("a boolean is not an exponent")
     n = integer_exponent(exponent)
     if n is not None:
         b = as_expr(base)
