@@ -12,6 +12,7 @@ by hand in the comments.
 from __future__ import annotations
 
 import math
+from fractions import Fraction
 
 import mpmath
 import numpy as np
@@ -757,3 +758,226 @@ def test_satellite_model_end_to_end():
     for i, n in enumerate(names):
         assert mp_in(truth[n], float(r.lo[i]), float(r.hi[i])), (n, r[i])
     assert float(r.hi[names.index("x1_0")]) < 4.05
+
+
+# -------------------------------------------------------------------------------------------
+# interval constants: every occurrence is its own value (never merged into one variable)
+# -------------------------------------------------------------------------------------------
+
+def contains(iv: Interval, q: Fraction) -> bool:
+    """Whether the non-empty scalar interval ``iv`` contains the exact rational ``q``."""
+    lo, hi = float(iv.lo), float(iv.hi)
+    return lo == lo and (lo == -INF or Fraction(lo) <= q) and (hi == INF or q <= Fraction(hi))
+
+
+def survives(model: Model, point: dict[str, Fraction]) -> None:
+    """``point`` (a solution of ``model``) is kept by ``CtcFwdBwd`` and by ``propagate``."""
+    names = list(point)
+    box = Interval([float(model.domains[n].lo) if n in model.domains else -INF for n in names],
+                   [float(model.domains[n].hi) if n in model.domains else INF for n in names])
+    r = CtcFwdBwd(model, names)(box)
+    for j, n in enumerate(names):
+        assert contains(r[j], point[n]), (n, point[n], r[j])
+    res = propagate(model, rel_eps=0.0)
+    assert res.consistent
+    for n in names:
+        assert contains(res[n], point[n]), (n, point[n], res[n])
+
+
+def unit_box_model(*cons) -> Model:
+    m = Model()
+    m.declare("x", (0, 1))
+    m.declare("y", (0, 1))
+    return m.add(*cons)
+
+
+def test_two_equal_interval_constants_are_two_values():
+    # x == [0, 1], y == [0, 1], x - y == 1: (x, y) = (1, 0) is a solution
+    m = unit_box_model(x == Interval(0, 1), y == Interval(0, 1), x - y == 1)
+    survives(m, {"x": Fraction(1), "y": Fraction(0)})
+    # one Const object used twice is two occurrences as well
+    c = Const(Interval(0, 1))
+    survives(unit_box_model(x == c, y == c, x - y == 1), {"x": Fraction(1), "y": Fraction(0)})
+
+
+def test_one_interval_constant_in_two_products():
+    # x*c == 1/4, y*c == 3/4, x == y with c in [0, 1]: x = y = 1 (c = 1/4, then c = 3/4)
+    for c in (Interval(0, 1), Const(Interval(0, 1))):
+        survives(unit_box_model(x * c == 0.25, y * c == 0.75, x == y),
+                 {"x": Fraction(1), "y": Fraction(1)})
+
+
+def test_equal_trees_over_an_interval_constant_stay_apart():
+    # x == c + 1, y == c + 1, x - y == 1: x = 2 (c = 1), y = 1 (c = 0)
+    c = Const(Interval(0, 1))
+    e = c + 1
+    for cons in ([x == c + 1, y == c + 1], [x == e, y == e]):
+        m = Model()
+        m.declare("x", (0, 3))
+        m.declare("y", (0, 3))
+        survives(m.add(*cons, x - y == 1), {"x": Fraction(2), "y": Fraction(1)})
+
+
+def test_decimals_in_one_float_gap_are_two_numbers():
+    # the text format's interval constants are decimals between two floats: 0.1 + 1e-20 and
+    # 0.1 + 2e-20 have the same enclosure but are two numbers (tape level: test_expr)
+    a, b = "0.10000000000000000001", "0.10000000000000000002"
+    text = (f"x in [0, 1], y in [0, 1];\nConstraints\n x = {a}, y = {b},\n"
+            " x - y = -0.00000000000000000001;")
+    survives(parse_model(text), {"x": Fraction(a), "y": Fraction(b)})
+    # 1e400 and 3e400 are both [MAX, +oo]: one shared slot C would make x*C = 1 and y*C = 3
+    # with x == y one node equal to both 1 and 3 (inconsistent); x = y = 1e-400 is a solution
+    text = "x in [0, 1], y in [0, 1];\nConstraints\n x = y, x*1e400 = 1, y*3e400 = 3;"
+    survives(parse_model(text), {"x": Fraction(1, 10**400), "y": Fraction(1, 10**400)})
+
+
+# a random model: base variables at exact dyadic values, interval constants each used several
+# times (a fresh value of the interval per occurrence), expression trees reused by identity,
+# definitions w_k == tree, and relations on the trees' exact values
+
+DYADIC = st.integers(-16, 16).map(lambda k: Fraction(k, 4))
+
+
+@st.composite
+def const_models(draw):
+    n_vars = draw(st.integers(1, 3))
+    values = {f"v{i}": draw(DYADIC) for i in range(n_vars)}
+    consts = []
+    for _ in range(draw(st.integers(1, 2))):
+        lo = draw(st.integers(-8, 7))
+        hi = draw(st.integers(lo + 1, 8))
+        consts.append((Fraction(lo, 4), Fraction(hi, 4)))
+    const_objs = [Const(Interval(float(lo), float(hi))) for lo, hi in consts]
+
+    def tree(depth):
+        kind = draw(st.integers(0, 3 if depth > 0 else 2))
+        if kind == 0:
+            return ("var", draw(st.sampled_from(sorted(values))))
+        if kind == 1:
+            return ("const", draw(st.integers(0, len(consts) - 1)))
+        if kind == 2:
+            return ("num", draw(DYADIC))
+        op = draw(st.sampled_from(["add", "sub", "mul", "sqr", "neg"]))
+        args = (tree(depth - 1),) if op in ("sqr", "neg") else (tree(depth - 1), tree(depth - 1))
+        return (op, *args)
+
+    def build(t):
+        """The expression (interval constants as Intervals or as the shared Const objects)."""
+        if t[0] == "var":
+            return Var(t[1])
+        if t[0] == "const":
+            j = t[1]
+            return const_objs[j] if draw(st.booleans()) else Interval(float(consts[j][0]),
+                                                                      float(consts[j][1]))
+        if t[0] == "num":
+            return Const(float(t[1]))
+        a = [build(s) for s in t[1:]]
+        if t[0] == "sqr":
+            return a[0] ** 2 if isinstance(a[0], Var | Op | Const) else Const(a[0]) ** 2
+        if t[0] == "neg":
+            return -(a[0] if not isinstance(a[0], Interval) else Const(a[0]))
+        l, r = (e if not isinstance(e, Interval) else Const(e) for e in a)
+        return {"add": l + r, "sub": l - r, "mul": l * r}[t[0]]
+
+    def value(t, occ):
+        """Exact value with a fresh value of each constant occurrence (drawn into ``occ``)."""
+        if t[0] == "var":
+            return values[t[1]]
+        if t[0] == "const":
+            lo, hi = consts[t[1]]
+            v = lo + (hi - lo) * draw(st.sampled_from([Fraction(0), Fraction(1, 4),
+                                                       Fraction(1, 2), Fraction(1)]))
+            occ.append(v)
+            return v
+        if t[0] == "num":
+            return t[1]
+        a = [value(s, occ) for s in t[1:]]
+        return {"add": lambda: a[0] + a[1], "sub": lambda: a[0] - a[1],
+                "mul": lambda: a[0] * a[1], "sqr": lambda: a[0] ** 2,
+                "neg": lambda: -a[0]}[t[0]]()
+
+    m = Model()
+    for n, v in values.items():
+        r = draw(st.sampled_from([0, 1, 4]))
+        m.declare(n, (float(v - r), float(v + r)))
+    point = dict(values)
+    trees = [tree(2) for _ in range(draw(st.integers(1, 3)))]
+    built = [build(t) for t in trees]
+    defs = []
+    for k in range(draw(st.integers(2, 5))):
+        i = draw(st.integers(0, len(trees) - 1))
+        # the same tree object (memoised by identity) or a rebuilt one
+        e = built[i] if draw(st.booleans()) else build(trees[i])
+        e = e if not isinstance(e, Interval) else Const(e)
+        occ: list[Fraction] = []
+        val = value(trees[i], occ)
+        how = draw(st.sampled_from(["define", "equal", "le", "in"]))
+        if how == "define":
+            w_ = Var(f"w{k}")
+            m.add(w_ == e)
+            point[w_.name] = val
+            defs.append(w_)
+        elif how == "equal":  # exact dyadic value: a float
+            m.add(e == float(val))
+        elif how == "le":
+            m.add(e <= float(val) + draw(st.sampled_from([0, 1])))
+        else:
+            m.add(e.in_((float(val), float(val) + 1)))
+    if len(defs) >= 2:  # relate two definitions through their exact difference
+        a_, b_ = defs[0], defs[1]
+        m.add(a_ - b_ == float(point[a_.name] - point[b_.name]))
+    return m, point
+
+
+@settings(max_examples=150, suppress_health_check=[HealthCheck.too_slow])
+@given(const_models())
+def test_solutions_with_interval_constants_survive(mp):
+    model, point = mp
+    note("\n".join(str(c) for c in model.constraints))
+    note(str(point))
+    survives(model, point)
+
+
+# -------------------------------------------------------------------------------------------
+# powers: pow(x, n), x^n, bd.pow(x, n), x**n are the integer power for an integer constant n
+# -------------------------------------------------------------------------------------------
+
+def test_pow_2_in_a_model_file_keeps_negative_solutions():
+    import boundest as bd
+
+    for text in ("pow(x, 2) = 4", "x^2 = 4", "pow(x, 2.0) = 4", "x^2.0 = 4"):
+        res = propagate(parse_model(f"x in [-3, 10]; Constraints {text};"), rel_eps=0.0)
+        assert res.consistent and float(res["x"].lo) == -2.0 and float(res["x"].hi) == 2.0
+    for e in (bd.pow(x, 2), x**2, x**2.0, bd.pow(x, 2.0)):
+        m = Model()
+        m.declare("x", (-3, 10))
+        res = propagate(m.add(e == 4), rel_eps=0.0)
+        assert float(res["x"].lo) == -2.0 and float(res["x"].hi) == 2.0
+    # a non-integer exponent is the real power: x >= 0
+    res = propagate(parse_model("x in [-3, 10]; Constraints pow(x, 0.5) = 2;"), rel_eps=0.0)
+    assert contains(res["x"], Fraction(4)) and float(res["x"].lo) >= 0.0
+
+
+@settings(max_examples=150)
+@given(st.integers(-6, 6), st.integers(-24, 24).map(lambda k: Fraction(k, 8)),
+       st.sampled_from(["pow(x, {n})", "x^{n}", "x^({n})", "pow(x, {n}.0)", "x^{n}.0",
+                        "py_pow", "py_starstar", "py_float"]))
+def test_integer_powers_keep_sampled_solutions(n, xv, spelling):
+    import boundest as bd
+
+    assume(not (n < 0 and xv == 0))
+    zv = xv ** n  # exact
+    lo, hi = float(zv), float(zv)
+    if Fraction(lo) > zv:
+        lo = float(np.nextafter(lo, -INF))
+    if Fraction(hi) < zv:
+        hi = float(np.nextafter(hi, INF))
+    if spelling.startswith("py"):
+        e = {"py_pow": bd.pow(x, n), "py_starstar": x**n, "py_float": x ** float(n)}[spelling]
+        m = Model()
+        m.declare("x", (-3, 3))
+        m.add(e.in_((lo, hi)))
+    else:
+        lit = spelling.format(n=n)  # x^-3, x^(-3), pow(x, -3.0), ...
+        m = parse_model(f"x in [-3, 3]; Constraints {lit} in [{lo!r}, {hi!r}];")
+    survives(m, {"x": xv})

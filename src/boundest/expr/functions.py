@@ -11,7 +11,7 @@ from collections.abc import Callable
 from typing import Any
 
 from .. import interval as iv
-from .nodes import Expr, Op, as_expr
+from .nodes import Expr, Op, as_expr, integer_exponent, power
 
 _UNARY: dict[str, Callable[..., Any]] = {
     "sqr": iv.sqr, "sqrt": iv.sqrt, "exp": iv.exp, "log": iv.log, "sin": iv.sin, "cos": iv.cos,
@@ -44,20 +44,28 @@ def _binary(name: str) -> Callable[[Any, Any], Any]:
 
     def func(x: Any, y: Any) -> Any:
         if isinstance(x, Expr) or isinstance(y, Expr):
-            if name == "pow" and not isinstance(y, Expr):
-                return as_expr(x) ** y  # integer exponents become pown
+            if name == "pow":
+                return power(x, y)  # an integer constant exponent is the integer power
             return Op(name, (as_expr(x), as_expr(y)))
         return f(x, y)
 
     func.__name__ = func.__qualname__ = name
     func.__doc__ = f"``{name}(x, y)``: interval enclosure, or an expression node."
+    if name == "pow":
+        func.__doc__ = ("``pow(x, y)``: interval enclosure, or an expression node. An integer "
+                        "constant ``y`` (``2``, ``2.0``, ``-3``) is the integer power (any sign "
+                        "of ``x``), any other ``y`` the real power (``x >= 0``); see "
+                        "``boundest.expr.nodes.power``.")
     return func
 
 
 def pown(x: Any, n: int) -> Any:
     """``x**n`` for an integer ``n``: interval enclosure, or an expression node."""
     if isinstance(x, Expr):
-        return x ** int(n)
+        k = integer_exponent(n)
+        if k is None:
+            raise ValueError(f"pown needs an integer exponent of magnitude <= 2**53, got {n!r}")
+        return power(x, k)
     return iv.pown(x, n)
 
 

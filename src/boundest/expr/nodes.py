@@ -6,10 +6,22 @@
 'x1_1 == x1_0 + 0.5 * x3_0 + w1_0'
 
 Expressions are immutable trees; the compiler (``tape.py``) shares equal sub-expressions.
+
+Constants: a degenerate constant (``lo == hi``) is that float. A non-degenerate one (an
+``Interval`` used in an expression) stands for *some* value of the interval, chosen
+independently at each occurrence, as interval evaluation does; the compiler never merges two
+occurrences, unless ``Const.exact`` says they denote the same real number (a decimal literal
+of the model text format).
+
+Powers: an integer constant exponent (``2``, ``2.0``, ``-3``, ``Const(3)``) is the integer power
+``pown`` (``sqr`` for 2), defined for every sign of the base; any other exponent is the real
+power ``pow``, defined for a base ``>= 0``. ``x ** n``, ``boundest.pow(x, n)`` and the text
+format's ``x^n`` and ``pow(x, n)`` all follow this rule (``power``).
 """
 
 from __future__ import annotations
 
+import math
 import numbers
 from collections.abc import Iterable
 
@@ -17,6 +29,7 @@ from ..interval import Interval, as_interval
 
 __all__ = [
     "BINARY",
+    "MAX_POWN_EXPONENT",
     "UNARY",
     "Const",
     "Constraint",
@@ -25,6 +38,8 @@ __all__ = [
     "Var",
     "VarFamily",
     "as_expr",
+    "integer_exponent",
+    "power",
     "variables",
 ]
 
@@ -34,6 +49,8 @@ UNARY = ("neg", "sqr", "sqrt", "exp", "log", "sin", "cos", "tan", "asin", "acos"
 #: Binary primitives.
 BINARY = ("add", "sub", "mul", "div", "pow", "atan2", "min", "max")
 _INFIX = {"add": ("+", 1), "sub": ("-", 1), "mul": ("*", 2), "div": ("/", 2)}
+#: Largest ``|n|`` of an integer exponent: the tape keeps exponents as float64, exact to 2**53.
+MAX_POWN_EXPONENT = 2**53
 
 
 class Expr:
@@ -75,12 +92,8 @@ class Expr:
         return self
 
     def __pow__(self, o: object) -> Expr:
-        # an integer-valued exponent (2 or 2.0) is the integer power, defined for any sign of
-        # the base; IEEE pow (x >= 0 only) would lose the negative solutions of x**2.0 == 4
-        if isinstance(o, numbers.Real) and not isinstance(o, bool) and float(o).is_integer():
-            n = int(o)
-            return Op("sqr", (self,)) if n == 2 else Op("pown", (self,), n)
-        return Op("pow", (self, as_expr(o)))
+        """``self ** o``: the integer power for an integer constant ``o`` (see ``power``)."""
+        return power(self, o)
 
     def __rpow__(self, o: object) -> Expr:
         return Op("pow", (as_expr(o), self))
@@ -115,15 +128,29 @@ class Expr:
 
 
 class Const(Expr):
-    """A constant, held as a scalar interval (a decimal literal is its outward enclosure)."""
+    """A constant, held as a scalar interval (a decimal literal is its outward enclosure).
 
-    __slots__ = ("value",)
+    Parameters
+    ----------
+    value : Interval or float
+        The constant; a non-degenerate interval stands for an unknown value inside it, chosen
+        independently at each occurrence.
+    exact : (sign, digits, exponent), optional
+        The real number ``sign * int(digits) * 10**exponent`` that ``value`` encloses, when it
+        is known (decimal literals); ``digits`` has no leading or trailing zero (zero is
+        ``(0, "", 0)``). Occurrences with equal ``exact`` denote the same number, so the
+        compiler may share them.
+    """
 
-    def __init__(self, value: Interval | float) -> None:
+    __slots__ = ("exact", "value")
+
+    def __init__(self, value: Interval | float, exact: tuple[int, str, int] | None = None
+                 ) -> None:
         v = as_interval(value)
         if v.shape != ():
             raise ValueError(f"a constant must be a scalar, got shape {v.shape}")
         self.value = v
+        self.exact = exact
 
     def __str__(self) -> str:
         lo, hi = float(self.value.lo), float(self.value.hi)
@@ -242,6 +269,69 @@ def as_expr(x: object) -> Expr:
     if isinstance(x, (Interval, numbers.Real)):
         return Const(x)  # type: ignore[arg-type]
     raise TypeError(f"cannot use {type(x).__name__} {x!r} in an expression")
+
+
+def integer_exponent(e: object) -> int | None:
+    """The integer ``n`` when ``e`` is an integer constant exponent, else None.
+
+    Integer constants are Python/NumPy integers, integer-valued floats (``2.0``), and
+    degenerate constants (``Const``, ``Interval``) with an integer value, of magnitude at most
+    ``MAX_POWN_EXPONENT``; booleans are not numbers here.
+    """
+    if isinstance(e, bool):
+        return None
+    if isinstance(e, numbers.Integral):
+        n = int(e)
+    elif isinstance(e, numbers.Real):
+        f = float(e)
+        if not (math.isfinite(f) and f.is_integer()):
+            return None
+        n = int(f)
+    elif isinstance(e, (Const, Interval)):
+        v = e.value if isinstance(e, Const) else e
+        if v.shape != ():
+            return None
+        lo, hi = float(v.lo), float(v.hi)
+        if not (lo == hi and math.isfinite(lo) and lo.is_integer()):
+            return None
+        n = int(lo)
+    else:
+        return None
+    return n if -MAX_POWN_EXPONENT <= n <= MAX_POWN_EXPONENT else None
+
+
+def power(base: object, exponent: object) -> Expr:
+    """``base ** exponent`` as an expression, the one power rule of both front ends.
+
+    An integer constant exponent (see ``integer_exponent``) gives the integer power: ``sqr`` for
+    2, else ``pown`` (any sign of the base; ``pown(x, -1) = 1/x``, ``pown(x, 0) = 1``). Any
+    other exponent (a non-integer, an interval, an expression) gives the real power ``pow``,
+    defined for ``base >= 0``.
+
+    Raises
+    ------
+    ValueError
+        For an integer-valued exponent beyond ``MAX_POWN_EXPONENT`` (not representable exactly
+        in a tape; ``pow`` would silently drop the negative bases).
+    TypeError
+        For a boolean exponent.
+    """
+    if isinstance(exponent, bool):
+        raise TypeError("a boolean is not an exponent")
+    n = integer_exponent(exponent)
+    if n is not None:
+        b = as_expr(base)
+        return Op("sqr", (b,)) if n == 2 else Op("pown", (b,), n)
+    e = as_expr(exponent)
+    if isinstance(e, Const):
+        lo, hi = float(e.value.lo), float(e.value.hi)
+        # an integer too large for a float64 exponent: a float, or a decimal such as 1e300
+        if (lo == hi and math.isfinite(lo) and lo.is_integer()) or (
+                e.exact is not None and e.exact[0] != 0 and e.exact[2] >= 0):
+            shown = (f"{'-' if e.exact[0] < 0 else ''}{e.exact[1][:20]}e{e.exact[2]}"
+                     if e.exact is not None else f"{lo:g}")
+            raise ValueError(f"integer exponent {shown} too large: |n| must be at most 2**53")
+    return Op("pow", (as_expr(base), e))
 
 
 def variables(items: Iterable[Expr | Constraint]) -> list[Var]:

@@ -6,6 +6,13 @@ computed once, also across constraints) and one *node* ``out = op(a, b)``. An eq
 identical, which are then merged too (congruence closure). Inequalities and ``in`` constraints
 become initial domains of slots. The result is the classic decomposition of a CSP into
 primitive constraints (seed 000 section 5, seed 004 section 6.4).
+
+A slot is one real value, so only constants known to be one number share a slot: degenerate
+constants by their float, decimal literals by their exact value (``Const.exact``). Every
+occurrence of any other (non-degenerate) interval constant is a fresh slot, and a
+sub-expression containing one is never shared by identity: each occurrence is an independent
+value of the interval, as in forward evaluation. Congruence closure then stays sound, since two
+nodes merge only when their argument slots are equal.
 """
 
 from __future__ import annotations
@@ -81,10 +88,11 @@ class _Builder:
         self.lo: list[float] = []
         self.hi: list[float] = []
         self.slot_of: dict[str, int] = {}
-        self.const_slot: dict[tuple[float, float], int] = {}
+        self.const_slot: dict[tuple, int] = {}  # constants that are one number
         self.node_of: dict[tuple, int] = {}
         self.nodes: list[tuple[int, int, int, int, float]] = []  # (op, out, a, b, param)
-        self.memo: dict[int, int] = {}  # id(expr) -> slot, for trees reused by identity
+        # id(expr) -> slot, for trees reused by identity (only those that are one value)
+        self.memo: dict[int, int] = {}
         self.keep: list[Expr] = []  # keep memoised expressions alive (ids stay unique)
 
     def new_slot(self, lo: float = -np.inf, hi: float = np.inf) -> int:
@@ -99,22 +107,37 @@ class _Builder:
         return s
 
     def expr(self, e: Expr) -> int:
+        """The slot of ``e`` (a fresh one where ``e`` holds a non-degenerate constant)."""
+        return self._expr(e)[0]
+
+    def _expr(self, e: Expr) -> tuple[int, bool]:
+        """``(slot, shared)``; ``shared`` is False when ``e`` contains an occurrence of a
+        non-degenerate constant, whose slot must not serve another occurrence of ``e``."""
         s = self.memo.get(id(e))
         if s is not None:
-            return s
+            return s, True
+        shared = True
         if isinstance(e, Var):
             s = self.var(e.name)
         elif isinstance(e, Const):
-            key = (float(e.value.lo), float(e.value.hi))
-            s = self.const_slot.get(key)
-            if s is None:
-                s = self.const_slot[key] = self.new_slot(*key)
+            lo, hi = float(e.value.lo), float(e.value.hi)
+            key: tuple | None = ("point", lo) if lo == hi else (
+                None if e.exact is None else ("exact", e.exact))
+            if key is None:
+                s, shared = self.new_slot(lo, hi), False
+            else:
+                s = self.const_slot.get(key)
+                if s is None:
+                    s = self.const_slot[key] = self.new_slot(lo, hi)
+                else:  # the same number: both enclosures contain it
+                    self.restrict(s, lo, hi)
         elif isinstance(e, Op):
-            args = [self.expr(x) for x in e.args]
-            a, b = args[0], (args[1] if len(args) == 2 else -1)
+            args = [self._expr(x) for x in e.args]
+            shared = all(sh for _, sh in args)
+            a, b = args[0][0], (args[1][0] if len(args) == 2 else -1)
             param = float(e.param) if e.param is not None else 0.0
             key = (_CODE[e.name], a, b, param)
-            node = self.node_of.get(key)
+            node = self.node_of.get(key)  # a fresh argument slot makes the key unique
             if node is None:
                 s = self.new_slot()
                 self.node_of[key] = len(self.nodes)
@@ -123,9 +146,10 @@ class _Builder:
                 s = self.nodes[node][1]
         else:
             raise TypeError(f"not an expression: {e!r}")
-        self.memo[id(e)] = s
-        self.keep.append(e)
-        return s
+        if shared:
+            self.memo[id(e)] = s
+            self.keep.append(e)
+        return s, shared
 
     def restrict(self, s: int, lo: float, hi: float) -> None:
         if lo != lo or hi != hi:  # an empty domain (NaN bounds): Python's max would drop it
