@@ -42,9 +42,10 @@ def _demo(args: argparse.Namespace) -> int:
 
 def _solve(args: argparse.Namespace) -> int:
     from .csp import propagate
-    from .expr import load_model
+    from .expr.parser import parse_model
+    from .scenarios._data import read_text
 
-    model = load_model(args.file)
+    model = parse_model(read_text(args.file), source=str(args.file))
     for key, value in model.options.items():
         print(f"note: option '{key} {value}' is not used by boundest")
     res = propagate(model, rel_eps=args.rel_eps)
@@ -57,9 +58,8 @@ def _solve(args: argparse.Namespace) -> int:
         print(f"  {name:<{width}} in {text}")
     if args.json:
         write_json({"file": str(args.file), "consistent": res.consistent,
-                     "evaluations": res.evaluations, "time_s": res.time_s,
-                     "domains": {n: None if bool(d.is_empty()) else [float(d.lo), float(d.hi)]
-                                 for n, d in res.domains.items()}}, args.json)
+                    "evaluations": res.evaluations, "time_s": res.time_s,
+                    "domains": res.domains}, args.json)
     return 0 if res.consistent else 1
 
 

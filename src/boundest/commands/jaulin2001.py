@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 
 from . import pyplot, save_figure, write_json
 
@@ -25,7 +26,7 @@ def run(args: argparse.Namespace) -> int:
             return " x ".join(f"[{_f(a)}, {_f(b)}]"
                               for a, b in zip(row["hull_lo"], row["hull_hi"], strict=True))
         print(f"{r['k']:>3} {fmt(r):>40} {r['boxes']:>6}   {fmt(n):>40} {n['boxes']:>6}")
-    empty = any(s["hull_lo"][0] is None for e in ("rcse", "ncse") for s in data[e]["sets"])
+    empty = any(math.isnan(s["hull_lo"][0]) for e in ("rcse", "ncse") for s in data[e]["sets"])
     if empty:
         print("proven INCONSISTENT: an empty set (the data contradict the model)")
     pyplot()  # the file-only backend, before plot_set_sequence makes its figure
@@ -37,10 +38,8 @@ def run(args: argparse.Namespace) -> int:
     return 1 if empty else 0
 
 
-def _f(v: float | str | None) -> str:
-    if v is None:
-        return "empty"
-    return v if isinstance(v, str) else f"{v:.3f}"
+def _f(v: float) -> str:
+    return "empty" if math.isnan(v) else f"{v:.3f}"
 
 
 def register(runs: argparse._SubParsersAction) -> None:
