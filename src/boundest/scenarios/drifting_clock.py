@@ -243,6 +243,15 @@ class ClockResult:
     def consistent(self) -> bool:
         return not self.empty
 
+    def __repr__(self) -> str:
+        """Counts and summary numbers, not the tubes (the fields hold them)."""
+        with np.errstate(invalid="ignore"):
+            width = float(np.nanmean(self.t.width())) if len(self.meas) else float("nan")
+        return (f"ClockResult(measurements={len(self.meas)}, slices={self.h.n_slices}, "
+                f"consistent={self.consistent}, converged={self.converged}, "
+                f"iterations={self.iterations}, time_s={self.time_s:.3g}, "
+                f"mean_t_i_width={width:.3g})")
+
     def to_json(self) -> dict:
         """The fields of ``boundest run drifting-clock --json``."""
         def fl(a: ArrayLike) -> list:

@@ -289,6 +289,15 @@ class RangeOnlyResult:
     def consistent(self) -> bool:
         return not self.empty
 
+    def __repr__(self) -> str:
+        """Counts and summary numbers, not the tubes (the fields hold them)."""
+        d = self.position_diagonal()
+        mean = f"{float(np.mean(d)):.3g}" if d.size and not self.empty else "nan"
+        return (f"RangeOnlyResult(measurements={len(self.meas)}, slices={self.x.n_slices}, "
+                f"consistent={self.consistent}, converged={self.converged}, "
+                f"iterations={self.iterations}, time_s={self.time_s:.3g}, "
+                f"mean_diagonal={mean})")
+
     def position_diagonal(self) -> NDArray[np.float64]:
         """``d`` at every gate: the diagonal of the position box ``[x1] x [x2]``."""
         return np.hypot(self.x.gates.width()[:, 0], self.x.gates.width()[:, 1])

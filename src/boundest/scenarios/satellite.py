@@ -241,6 +241,15 @@ class SatelliteResult:
     def box(self, k: int) -> Interval:
         return Interval._new(self.x_lo[k], self.x_hi[k])
 
+    def __repr__(self) -> str:
+        """Counts and mean widths, not the enclosures (``x_lo``, ``x_hi`` hold them)."""
+        with np.errstate(invalid="ignore"):
+            w = np.nanmean(self.x_hi - self.x_lo, axis=0) if self.consistent else []
+        widths = ", ".join(f"{v:.3g}" for v in w)
+        return (f"SatelliteResult(k_max={self.k_max}, consistent={self.consistent}, "
+                f"beta={self.beta:g}, evaluations={self.evaluations}, "
+                f"time_s={self.time_s:.3g}, mean_widths=[{widths}])")
+
 
 def _state_names(K: int) -> list[list[str]]:
     return [[f"x{i}_{k}" for i in (1, 2, 3, 4)] for k in range(K + 2)]
