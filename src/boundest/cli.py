@@ -72,7 +72,8 @@ def build_parser() -> argparse.ArgumentParser:
     demo = sub.add_parser("demo", help="enclose the graph of a function with interval boxes "
                                        "and draw it")
     demo.add_argument("--out", default="out", help="folder for figures (default: out)")
-    demo.add_argument("--json", help="also write the summary as JSON to this file")
+    demo.add_argument("--json", help="also write the summary as JSON to this file "
+                                     "(strict JSON: docs/json.md)")
     demo.set_defaults(func=_demo)
 
     run = sub.add_parser("run", help="run a seed scenario end to end on its embedded data")
@@ -83,7 +84,8 @@ def build_parser() -> argparse.ArgumentParser:
     solve = sub.add_parser("solve", help="propagate a model file and print every domain")
     solve.add_argument("file", help="model in the text format (docs: boundest.expr.parser)")
     solve.add_argument("--rel-eps", type=float, default=1e-3)
-    solve.add_argument("--json", help="write the domains as JSON to this file")
+    solve.add_argument("--json", help="write the domains as JSON to this file "
+                                      "(strict JSON: docs/json.md)")
     solve.set_defaults(func=_solve)
     return parser
 

@@ -45,11 +45,13 @@ def _f(v: float) -> str:
 def register(runs: argparse._SubParsersAction) -> None:
     """Add ``boundest run jaulin2001`` and its options."""
     p = runs.add_parser("jaulin2001", help="seed 002: causal and non-causal set estimation")
-    p.add_argument("--data", help="measurement CSV k,y_lo,y_hi (default: the embedded one)")
+    p.add_argument("--data", help="measurement CSV, columns k,y_lo,y_hi (default: the embedded "
+                   "one; docs/data-format.md)")
     p.add_argument("--eps", type=float, default=0.01,
                    help="subpaving precision (default 0.01)")
     p.add_argument("--boxes", action="store_true",
                    help="box domains (hull consistency) instead of subpavings")
     p.add_argument("--out", default="out", help="folder for figures (default: out)")
-    p.add_argument("--json", help="write the sets' hulls, box counts and areas to this file")
+    p.add_argument("--json", help="write the sets' hulls, box counts and areas to this file "
+                   "(strict JSON: docs/json.md)")
     p.set_defaults(func=run)
