@@ -302,3 +302,14 @@ def test_solve_json_with_unbounded_and_empty_domains(tmp_path, capsys):
     assert main(["solve", str(m), "--json", str(js)]) == 1
     data = _strict(js.read_text())
     assert data["consistent"] is False and data["domains"] == {"x": None, "y": None}
+
+
+def test_satellite_data_is_never_truncated_silently(tmp_path, capsys):
+    rows = _lines(LOADERS[0])[:42]
+    f, js = tmp_path / "k40.csv", tmp_path / "s.json"
+    f.write_text(_text(rows))
+    assert main(["run", "satellite", "--data", str(f), "--out", str(tmp_path), "--json",
+                 str(js)]) == 0
+    assert _strict(js.read_text())["k_max"] == 40
+    rc, err = _run(["run", "satellite", "--data", str(f), "--kmax", "200"], capsys)
+    assert rc == 2 and len(err) == 1 and f"{f}:42: the file ends at k = 40" in err[0], err

@@ -56,8 +56,8 @@ def run(args: argparse.Namespace) -> int:
 def register(runs: argparse._SubParsersAction) -> None:
     """Add ``boundest run satellite`` and its options."""
     sat = runs.add_parser("satellite", help="seed 000: satellite localisation as a CSP")
-    sat.add_argument("--kmax", type=int, choices=(200, 800), default=200,
-                     help="horizon (default 200)")
+    sat.add_argument("--kmax", type=int, choices=(200, 800), default=None,
+                     help="horizon (default: 200, or every row of --data)")
     sat.add_argument("--data", help="measurement CSV, columns k,y1_lo,y1_hi,y2_lo,y2_hi,"
                                     "y3_lo,y3_hi (default: the embedded one for --kmax; "
                                     "docs/data-format.md)")

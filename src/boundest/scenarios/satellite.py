@@ -29,7 +29,7 @@ from ..expr import Model, VarFamily
 from ..expr.functions import sqrt
 from ..expr.tape import Tape, compile_model
 from ..interval import Interval
-from ._data import DataError, check_index, embedded, read_csv
+from ._data import check_index, embedded, read_csv
 
 __all__ = [
     "DELTA",
@@ -86,7 +86,8 @@ def load(path: str | Path | None = None, k_max: int | None = None) -> Measuremen
     y_hi = np.stack([cols[f"y{i}_hi"] for i in (1, 2, 3)], axis=1)
     if k_max is not None:
         if not 1 <= k_max <= len(k) - 1:
-            raise DataError(f"{path}: k_max = {k_max} but the file holds k = 0..{len(k) - 1}")
+            raise cols.error(len(k) - 1, f"the file ends at k = {len(k) - 1}, but k_max = "
+                                         f"{k_max} was asked")
         y_lo, y_hi = y_lo[: k_max + 1], y_hi[: k_max + 1]
     return Measurements(y_lo, y_hi, str(path))
 
