@@ -52,6 +52,7 @@ def test_propagation_repr_shows_counts_not_domains():
 
 
 def test_scenario_result_reprs_are_short():
+    assert repr(sat.load()).startswith("Measurements(k_max=200, source=")
     res = sat.solve(sat.load(k_max=40))
     assert len(repr(res)) < 300 and "k_max=40" in repr(res)
     j = jw.solve(jw.load(), domains="boxes")

@@ -68,6 +68,10 @@ class Measurements:
     def k_max(self) -> int:
         return len(self.y_lo) - 1
 
+    def __repr__(self) -> str:
+        """The size and source, not the data (``y_lo``, ``y_hi`` hold them)."""
+        return f"Measurements(k_max={self.k_max}, source={self.source!r})"
+
 
 def load(path: str | Path | None = None, k_max: int | None = None) -> Measurements:
     """Read measurements (default: the embedded ``satellite_k200.csv`` or ``_k800`` file).
