@@ -42,9 +42,10 @@ def _demo(args: argparse.Namespace) -> int:
 
 def _solve(args: argparse.Namespace) -> int:
     from .csp import propagate
-    from .expr import load_model
+    from .expr.parser import parse_model
+    from .scenarios._data import read_text
 
-    model = load_model(args.file)
+    model = parse_model(read_text(args.file), source=str(args.file))
     for key, value in model.options.items():
         print(f"note: option '{key} {value}' is not used by boundest")
     res = propagate(model, rel_eps=args.rel_eps)
@@ -57,9 +58,8 @@ def _solve(args: argparse.Namespace) -> int:
         print(f"  {name:<{width}} in {text}")
     if args.json:
         write_json({"file": str(args.file), "consistent": res.consistent,
-                     "evaluations": res.evaluations, "time_s": res.time_s,
-                     "domains": {n: None if bool(d.is_empty()) else [float(d.lo), float(d.hi)]
-                                 for n, d in res.domains.items()}}, args.json)
+                    "evaluations": res.evaluations, "time_s": res.time_s,
+                    "domains": res.domains}, args.json)
     return 0 if res.consistent else 1
 
 
@@ -72,7 +72,8 @@ def build_parser() -> argparse.ArgumentParser:
     demo = sub.add_parser("demo", help="enclose the graph of a function with interval boxes "
                                        "and draw it")
     demo.add_argument("--out", default="out", help="folder for figures (default: out)")
-    demo.add_argument("--json", help="also write the summary as JSON to this file")
+    demo.add_argument("--json", help="also write the summary as JSON to this file "
+                                     "(strict JSON: docs/json.md)")
     demo.set_defaults(func=_demo)
 
     run = sub.add_parser("run", help="run a seed scenario end to end on its embedded data")
@@ -83,7 +84,8 @@ def build_parser() -> argparse.ArgumentParser:
     solve = sub.add_parser("solve", help="propagate a model file and print every domain")
     solve.add_argument("file", help="model in the text format (docs: boundest.expr.parser)")
     solve.add_argument("--rel-eps", type=float, default=1e-3)
-    solve.add_argument("--json", help="write the domains as JSON to this file")
+    solve.add_argument("--json", help="write the domains as JSON to this file "
+                                      "(strict JSON: docs/json.md)")
     solve.set_defaults(func=_solve)
     return parser
 

@@ -48,10 +48,12 @@ def register(runs: argparse._SubParsersAction) -> None:
     """Add ``boundest run drifting-clock`` and its options."""
     p = runs.add_parser("drifting-clock", help="seed 001: correcting a drifting clock")
     p.add_argument("--dt", type=float, default=0.01, help="slice duration (default 0.01)")
-    p.add_argument("--data", help="measurement CSV (default: the embedded Table 2)")
+    p.add_argument("--data", help="measurement CSV, columns i,tau,z_lo,z_hi (default: the "
+                   "embedded Table 2; docs/data-format.md)")
     p.add_argument("--rel-eps", type=float, default=1e-4,
                    help="stop when an iteration shrinks the domains by less than this fraction "
                         "(default 1e-4)")
     p.add_argument("--out", default="out", help="folder for figures (default: out)")
-    p.add_argument("--json", help="write [h], [y] and the [t_i] as JSON to this file")
+    p.add_argument("--json", help="write [h], [y] and the [t_i] as JSON to this file "
+                   "(strict JSON: docs/json.md)")
     p.set_defaults(func=run)

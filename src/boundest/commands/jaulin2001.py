@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 
 from . import pyplot, save_figure, write_json
 
@@ -25,7 +26,7 @@ def run(args: argparse.Namespace) -> int:
             return " x ".join(f"[{_f(a)}, {_f(b)}]"
                               for a, b in zip(row["hull_lo"], row["hull_hi"], strict=True))
         print(f"{r['k']:>3} {fmt(r):>40} {r['boxes']:>6}   {fmt(n):>40} {n['boxes']:>6}")
-    empty = any(s["hull_lo"][0] is None for e in ("rcse", "ncse") for s in data[e]["sets"])
+    empty = any(math.isnan(s["hull_lo"][0]) for e in ("rcse", "ncse") for s in data[e]["sets"])
     if empty:
         print("proven INCONSISTENT: an empty set (the data contradict the model)")
     pyplot()  # the file-only backend, before plot_set_sequence makes its figure
@@ -37,20 +38,20 @@ def run(args: argparse.Namespace) -> int:
     return 1 if empty else 0
 
 
-def _f(v: float | str | None) -> str:
-    if v is None:
-        return "empty"
-    return v if isinstance(v, str) else f"{v:.3f}"
+def _f(v: float) -> str:
+    return "empty" if math.isnan(v) else f"{v:.3f}"
 
 
 def register(runs: argparse._SubParsersAction) -> None:
     """Add ``boundest run jaulin2001`` and its options."""
     p = runs.add_parser("jaulin2001", help="seed 002: causal and non-causal set estimation")
-    p.add_argument("--data", help="measurement CSV k,y_lo,y_hi (default: the embedded one)")
+    p.add_argument("--data", help="measurement CSV, columns k,y_lo,y_hi (default: the embedded "
+                   "one; docs/data-format.md)")
     p.add_argument("--eps", type=float, default=0.01,
                    help="subpaving precision (default 0.01)")
     p.add_argument("--boxes", action="store_true",
                    help="box domains (hull consistency) instead of subpavings")
     p.add_argument("--out", default="out", help="folder for figures (default: out)")
-    p.add_argument("--json", help="write the sets' hulls, box counts and areas to this file")
+    p.add_argument("--json", help="write the sets' hulls, box counts and areas to this file "
+                   "(strict JSON: docs/json.md)")
     p.set_defaults(func=run)

@@ -54,12 +54,14 @@ def register(runs: argparse._SubParsersAction) -> None:
     """Add ``boundest run range-only`` and its options."""
     p = runs.add_parser("range-only", help="seed 001: range-only robot with uncertain times")
     p.add_argument("--dt", type=float, default=0.01, help="slice duration (default 0.01)")
-    p.add_argument("--data", help="measurement CSV (default: the embedded Table 1)")
-    p.add_argument("--beacons", help="beacon CSV (default: the embedded one)")
+    p.add_argument("--data", help="measurement CSV, columns i,beacon,t_lo,t_hi,z_lo,z_hi "
+                   "(default: the embedded Table 1; docs/data-format.md)")
+    p.add_argument("--beacons", help="beacon CSV, columns beacon,bx,by (default: the embedded one)")
     p.add_argument("--rel-eps", type=float, default=1e-4,
                    help="stop when an iteration shrinks the domains by less than this fraction "
                         "(default 1e-4)")
     p.add_argument("--max-iter", type=int, default=200, help="iteration limit (default 200)")
     p.add_argument("--out", default="out", help="folder for figures (default: out)")
-    p.add_argument("--json", help="write the tubes and measurement boxes as JSON to this file")
+    p.add_argument("--json", help="write the tubes and measurement boxes as JSON to this file "
+                   "(strict JSON: docs/json.md)")
     p.set_defaults(func=run)

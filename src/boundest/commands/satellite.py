@@ -56,14 +56,17 @@ def run(args: argparse.Namespace) -> int:
 def register(runs: argparse._SubParsersAction) -> None:
     """Add ``boundest run satellite`` and its options."""
     sat = runs.add_parser("satellite", help="seed 000: satellite localisation as a CSP")
-    sat.add_argument("--kmax", type=int, choices=(200, 800), default=200,
-                     help="horizon (default 200)")
-    sat.add_argument("--data", help="measurement CSV (default: the embedded one for --kmax)")
+    sat.add_argument("--kmax", type=int, choices=(200, 800), default=None,
+                     help="horizon (default: 200, or every row of --data)")
+    sat.add_argument("--data", help="measurement CSV, columns k,y1_lo,y1_hi,y2_lo,y2_hi,"
+                                    "y3_lo,y3_hi (default: the embedded one for --kmax; "
+                                    "docs/data-format.md)")
     sat.add_argument("--rel-eps", type=float, default=1e-3,
                      help="propagation stops when no domain shrinks by more than this "
                           "fraction of its width (default 1e-3)")
     sat.add_argument("--beta-tuning", action="store_true",
                      help="if the CSP is empty, search the smallest relaxation beta")
     sat.add_argument("--out", default="out", help="folder for figures (default: out)")
-    sat.add_argument("--json", help="write the enclosures as JSON to this file")
+    sat.add_argument("--json", help="write the enclosures as JSON to this file "
+                   "(strict JSON: docs/json.md)")
     sat.set_defaults(func=run)

@@ -46,6 +46,16 @@ class Propagation:
     def __getitem__(self, name: str) -> Interval:
         return self.domains[name]
 
+    def __repr__(self) -> str:
+        """Counts and summary numbers, never every domain (``domains`` holds them)."""
+        doms = list(self.domains.values())
+        empty = sum(int(np.count_nonzero(d.is_empty())) for d in doms)
+        unbounded = sum(int(np.count_nonzero(~d.is_bounded())) for d in doms)
+        return (f"Propagation(consistent={self.consistent}, variables={len(doms)}, "
+                f"empty={empty}, unbounded={unbounded}, evaluations={self.evaluations}, "
+                f"iterations={self.iterations:.3g}, time_s={self.time_s:.3g}, "
+                f"n_nodes={self.n_nodes}, n_slots={self.n_slots})")
+
 
 def slot_users(tape: Tape) -> tuple[np.ndarray, np.ndarray]:
     """CSR lists of the nodes that use each slot (as output or argument)."""

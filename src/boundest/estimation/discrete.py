@@ -97,6 +97,13 @@ class ChainEstimate:
     time_s: float
     stats: dict
 
+    def __repr__(self) -> str:
+        """Counts and timing, not the domains (``x``, ``y`` hold them)."""
+        boxes = sum(len(d) if isinstance(d, Subpaving) else int(np.prod(d.shape[:-1]))
+                    for d in self.x)
+        return (f"ChainEstimate(K={len(self.x) - 1}, domains={self.domains!r}, "
+                f"boxes={boxes}, time_s={self.time_s:.3g})")
+
     def hull(self) -> Interval:
         """Interval hulls of the ``x`` domains, shape ``(..., K + 1, nx)``."""
         hs = [d.hull() if isinstance(d, Subpaving) else d for d in self.x]

@@ -26,6 +26,25 @@ def _fmt(v: float) -> str:
     return repr(float(v))
 
 
+#: an Interval's repr shows every element up to this size, and summarises beyond it
+_REPR_THRESHOLD = 1000
+#: elements shown at each end of every axis of a summarised repr
+_REPR_EDGE = 3
+
+
+def _nested(lo: NDArray, hi: NDArray, edge: int | None) -> str:
+    """``[[a, b], ...]`` for arrays of bounds; with ``edge``, an axis longer than ``2 edge`` shows
+    its first and last ``edge`` entries around ``...`` (only those elements are formatted)."""
+    if lo.ndim == 0:
+        return Interval._str_scalar(lo, hi)
+    n = lo.shape[0]
+    if edge is not None and n > 2 * edge:
+        head = [_nested(lo[i], hi[i], edge) for i in range(edge)]
+        tail = [_nested(lo[i], hi[i], edge) for i in range(n - edge, n)]
+        return "[" + ", ".join([*head, "...", *tail]) + "]"
+    return "[" + ", ".join(_nested(lo[i], hi[i], edge) for i in range(n)) + "]"
+
+
 def _bad_value(lo: NDArray, hi: NDArray, mask: NDArray, why: str) -> ValueError:
     idx = tuple(int(i) for i in np.argwhere(mask)[0]) if mask.ndim else ()
     where = f" at index {idx}" if idx else ""
@@ -157,11 +176,14 @@ class Interval:
         return Interval._new(self.lo.reshape(*shape), self.hi.reshape(*shape))
 
     def __repr__(self) -> str:
+        """``Interval([[0.0, 1.0], [1.0, inf]])``; beyond ``_REPR_THRESHOLD`` elements, only the
+        first and last ``_REPR_EDGE`` along each axis, ``...`` between, and the shape (as NumPy
+        summarises)."""
         if self.lo.ndim == 0:
             return f"Interval({self._str_scalar(self.lo, self.hi)})"
-        items = [self._str_scalar(a, b) for a, b in zip(self.lo.flat, self.hi.flat, strict=True)]
-        nested = np.array(items, dtype=object).reshape(self.shape).tolist()
-        return f"Interval({nested!r})".replace("'", "")
+        if self.size <= _REPR_THRESHOLD:
+            return f"Interval({_nested(self.lo, self.hi, None)})"
+        return f"Interval({_nested(self.lo, self.hi, _REPR_EDGE)}, shape={self.shape})"
 
     @staticmethod
     def _str_scalar(a: float, b: float) -> str:

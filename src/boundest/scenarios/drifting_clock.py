@@ -24,7 +24,6 @@ distance at ``h^{-1}(tau_i)``; tests check it).
 
 from __future__ import annotations
 
-import csv
 import math
 import time
 from dataclasses import dataclass
@@ -38,7 +37,7 @@ from ..expr import Var
 from ..expr import functions as ef
 from ..interval import Interval
 from ..tube import ContractorNetwork, CtcDeriv, CtcEval, CtcSlices, Tube, time_grid
-from ._data import DataError, embedded, read_csv
+from ._data import check_index, check_sorted, embedded, read_csv
 
 __all__ = [
     "DEPTH",
@@ -88,20 +87,24 @@ class ClockMeasurements:
 
 
 def load(path: str | Path | None = None) -> ClockMeasurements:
-    """Read Table 2 (default: the embedded ``rohou2018_clock.csv``: columns ``i, tau, z_lo,
-    z_hi``). Values are decimals, enclosed one ulp outward. Errors (one ``DataError`` naming
-    file, line and value): missing columns, non-numbers, ``z_lo > z_hi``, a negative ``tau`` or
-    ``z_hi``."""
+    """Read Table 2 (default: the embedded ``rohou2018_clock.csv``).
+
+    Columns ``i, tau, z_lo, z_hi`` (no others); rows ``i = 1, 2, ...`` in order, ``tau``
+    strictly increasing (a clock time is exact and finite); ``z_lo`` may be ``-inf`` and
+    ``z_hi`` ``inf`` (a distance bounded on one side only). Values are decimals, enclosed one
+    ulp outward. Errors (one ``DataError`` naming file, line and value): missing or unexpected
+    columns, non-numbers, ``z_lo > z_hi``, a repeated or unsorted row, a negative ``tau`` or
+    ``z_hi``.
+    """
     path = Path(embedded("rohou2018_clock.csv") if path is None else path)
-    cols = read_csv(path, ["tau", "z_lo", "z_hi"])
+    cols = read_csv(path, {"i": "finite", "tau": "finite", "z_lo": "lo", "z_hi": "hi"})
     for name in ("tau", "z_hi"):
         bad = np.flatnonzero(cols[name] < 0)
         if bad.size:
             k = int(bad[0])
-            with path.open(newline="") as fh:  # the line of the k-th data row (blank lines skipped)
-                lines = [n for n, row in enumerate(csv.reader(fh), start=1)
-                         if n > 1 and any(c.strip() for c in row)]
-            raise DataError(f"{path}:{lines[k]}: {name} = {float(cols[name][k])!r} is negative")
+            raise cols.error(k, f"{name} = {float(cols[name][k])!r} is negative")
+    check_index(cols, "i", 1)
+    check_sorted(cols, "tau", strict=True)
     tau = Interval._new(np.nextafter(cols["tau"], -np.inf), np.nextafter(cols["tau"], np.inf))
     z = Interval._new(np.nextafter(cols["z_lo"], -np.inf), np.nextafter(cols["z_hi"], np.inf))
     return ClockMeasurements(tau, z, str(path))
@@ -239,6 +242,15 @@ class ClockResult:
     @property
     def consistent(self) -> bool:
         return not self.empty
+
+    def __repr__(self) -> str:
+        """Counts and summary numbers, not the tubes (the fields hold them)."""
+        with np.errstate(invalid="ignore"):
+            width = float(np.nanmean(self.t.width())) if len(self.meas) else float("nan")
+        return (f"ClockResult(measurements={len(self.meas)}, slices={self.h.n_slices}, "
+                f"consistent={self.consistent}, converged={self.converged}, "
+                f"iterations={self.iterations}, time_s={self.time_s:.3g}, "
+                f"mean_t_i_width={width:.3g})")
 
     def to_json(self) -> dict:
         """The fields of ``boundest run drifting-clock --json``."""

@@ -21,7 +21,7 @@ from ..expr.functions import cos as _cos
 from ..expr.functions import sin as _sin
 from ..interval import Interval
 from ..paving import Subpaving
-from ._data import embedded, read_csv
+from ._data import check_index, embedded, read_csv
 
 __all__ = ["FRAME", "NOISE", "Jaulin2001", "Simulation", "load", "simulate", "solve", "system",
            "to_json"]
@@ -39,14 +39,14 @@ def system() -> DiscreteSystem:
 
 
 def load(path: str | Path | None = None) -> Interval:
-    """The measurement sets ``Y(k)``, k = 1..K, as an Interval of shape ``(K, 1)``."""
+    """The measurement sets ``Y(k)``, k = 1..K, as an Interval of shape ``(K, 1)``.
+
+    Columns ``k, y_lo, y_hi`` (no others), rows ``k = 1, 2, ...`` in order; ``y_lo`` may be
+    ``-inf`` and ``y_hi`` ``inf`` (no measurement at ``k``: ``Y(k)`` unbounded).
+    """
     path = embedded("jaulin2001.csv") if path is None else Path(path)
-    d = read_csv(path, ["k", "y_lo", "y_hi"])
-    k = d["k"]
-    if not np.array_equal(k, np.arange(1, k.size + 1)):
-        bad = int(np.flatnonzero(k != np.arange(1, k.size + 1))[0])
-        raise ValueError(f"{path}:{bad + 2}: k = {float(k[bad])!r}, expected {bad + 1} "
-                         "(rows k = 1, 2, ... in order)")
+    d = read_csv(path, {"k": "finite", "y_lo": "lo", "y_hi": "hi"})
+    check_index(d, "k", 1)
     return Interval(d["y_lo"][:, None], d["y_hi"][:, None])
 
 
@@ -108,7 +108,11 @@ def _areas(d: Interval | Subpaving) -> tuple[int, float, float]:
 
 
 def to_json(res: Jaulin2001) -> dict:
-    """Per k and estimator: interval hull, number of boxes, outer and inner areas."""
+    """Per k and estimator: interval hull, number of boxes, outer and inner areas.
+
+    An empty set has NaN hull bounds, an unbounded one infinite bounds or area
+    (``boundest.commands.jsonable`` writes them as ``null`` and ``"inf"``).
+    """
     out: dict = {"domains": res.domains, "eps": res.eps,
                  "x0_prior": [[float(a), float(b)] for a, b in zip(FRAME.lo, FRAME.hi,
                                                                    strict=True)]
@@ -118,17 +122,8 @@ def to_json(res: Jaulin2001) -> dict:
         rows = []
         for k, d in enumerate(est.x):
             n, outer, inner = _areas(d)
-            rows.append({"k": k, "hull_lo": [_num(v) for v in hull.lo[k]],
-                         "hull_hi": [_num(v) for v in hull.hi[k]], "boxes": n,
-                         "area_outer": _num(outer), "area_inner": _num(inner)})
+            rows.append({"k": k, "hull_lo": [float(v) for v in hull.lo[k]],
+                         "hull_hi": [float(v) for v in hull.hi[k]], "boxes": n,
+                         "area_outer": float(outer), "area_inner": float(inner)})
         out[name] = {"time_s": est.time_s, "stats": est.stats, "sets": rows}
     return out
-
-
-def _num(v: float) -> float | str | None:
-    v = float(v)
-    if np.isnan(v):
-        return None
-    if np.isinf(v):
-        return "inf" if v > 0 else "-inf"
-    return v

@@ -22,7 +22,6 @@ nothing then, and no measurement could ever be used). The truth used by the seed
 
 from __future__ import annotations
 
-import csv
 import math
 import time
 from dataclasses import dataclass, field
@@ -36,7 +35,7 @@ from ..expr import Var
 from ..expr import functions as ef
 from ..interval import Interval
 from ..tube import ContractorNetwork, CtcDeriv, CtcEval, CtcSlices, Tube, time_grid
-from ._data import DataError, embedded, read_csv
+from ._data import check_index, check_sorted, embedded, read_csv
 
 __all__ = [
     "T0",
@@ -95,53 +94,54 @@ class Measurements:
         return self.t.shape[0]
 
 
-def _read_names(path: Path, column: str) -> list[tuple[int, str]]:
-    """(line, text) of a text column of a CSV file with a header line."""
-    with path.open(newline="") as fh:
-        reader = csv.reader(fh)
-        header = [h.strip() for h in next(reader)]
-        j = header.index(column)
-        return [(line, row[j].strip()) for line, row in enumerate(reader, start=2)
-                if row and any(c.strip() for c in row)]
-
-
 def load(path: str | Path | None = None, beacons: str | Path | None = None,
          domain: tuple[float, float] = (T0, TF)) -> Measurements:
     """Read Table 1 (default: the embedded ``rohou2018_robot.csv`` and
     ``rohou2018_beacons.csv``).
 
-    The measurement file has columns ``i, beacon, t_lo, t_hi, z_lo, z_hi``; the beacon file
-    ``beacon, bx, by``. Every value is taken as a decimal number and enclosed one ulp outward.
-    Errors (one ``DataError`` naming file, line and value): missing columns, non-numbers,
-    ``lo > hi``, an unknown or duplicated beacon name, a time interval outside ``domain``, a
-    negative distance bound ``z_hi < 0``.
+    The measurement file has columns ``i, beacon, t_lo, t_hi, z_lo, z_hi`` (no others), rows
+    ``i = 1, 2, ...`` in order and sorted by ``t_lo``; the beacon file ``beacon, bx, by``.
+    Times and beacon positions must be finite; ``z_lo`` may be ``-inf`` and ``z_hi`` ``inf``
+    (a range bounded on one side only). Every value is taken as a decimal number and enclosed
+    one ulp outward. Errors (one ``DataError`` naming file, line and value): missing or
+    unexpected columns, non-numbers, ``lo > hi``, an unknown or duplicated beacon name, a
+    repeated or unsorted row, a time interval outside ``domain``, a negative distance bound
+    ``z_hi < 0``.
     """
     path = Path(embedded("rohou2018_robot.csv") if path is None else path)
     bpath = Path(embedded("rohou2018_beacons.csv") if beacons is None else beacons)
-    bcols = read_csv(bpath, ["bx", "by"])
+    bcols = read_csv(bpath, {"beacon": "text", "bx": "finite", "by": "finite"})
     names: dict[str, int] = {}
-    for line, name in _read_names(bpath, "beacon"):
+    for j, name in enumerate(bcols["beacon"]):
         if not name:
-            raise DataError(f"{bpath}:{line}: empty beacon name")
+            raise bcols.error(j, "empty beacon name")
         if name in names:
-            raise DataError(f"{bpath}:{line}: beacon {name!r} defined twice")
+            raise bcols.error(j, f"beacon {name!r} defined twice")
         names[name] = len(names)
-    cols = read_csv(path, ["t_lo", "t_hi", "z_lo", "z_hi"])
-    rows = _read_names(path, "beacon")
-    beacon = np.empty(len(rows), dtype=np.intp)
-    for k, (line, name) in enumerate(rows):
+    cols = read_csv(path, {"i": "finite", "beacon": "text", "t_lo": "finite", "t_hi": "finite",
+                           "z_lo": "lo", "z_hi": "hi"})
+    beacon = np.empty(len(cols), dtype=np.intp)
+    for k, name in enumerate(cols["beacon"]):
         if name not in names:
-            raise DataError(f"{path}:{line}: unknown beacon {name!r} (known: "
-                            f"{', '.join(names)} in {bpath})")
+            raise cols.error(k, f"unknown beacon {name!r} (known: {', '.join(names)} in "
+                                f"{bpath})")
         beacon[k] = names[name]
-    for k, (line, _) in enumerate(rows):
+    for k in range(len(cols)):
         a, b = float(cols["t_lo"][k]), float(cols["t_hi"][k])
         if a < domain[0] or b > domain[1]:
-            raise DataError(f"{path}:{line}: time interval [{a!r}, {b!r}] is outside the "
-                            f"mission [{domain[0]!r}, {domain[1]!r}]")
+            raise cols.error(k, f"time interval [{a!r}, {b!r}] is outside the mission "
+                                f"[{domain[0]!r}, {domain[1]!r}]")
         if cols["z_hi"][k] < 0:
-            raise DataError(f"{path}:{line}: z_hi = {float(cols['z_hi'][k])!r} is negative "
-                            "(a distance)")
+            raise cols.error(k, f"z_hi = {float(cols['z_hi'][k])!r} is negative (a distance)")
+    check_index(cols, "i", 1)
+    check_sorted(cols, "t_lo", strict=False)
+    tl, th = cols["t_lo"], cols["t_hi"]
+    twice = np.flatnonzero((tl[1:] == tl[:-1]) & (th[1:] == th[:-1]) & (beacon[1:] == beacon[:-1]))
+    if twice.size:
+        j = int(twice[0]) + 1
+        raise cols.error(j, f"beacon {cols['beacon'][j]!r} at t in [{float(tl[j])!r}, "
+                            f"{float(th[j])!r}] repeats line {int(cols.lines[j - 1])} (the same "
+                            "measurement twice)")
     t = Interval._new(*_outward(cols["t_lo"], cols["t_hi"]))
     t = Interval._new(np.maximum(t.lo, domain[0]), np.minimum(t.hi, domain[1]))
     z = Interval._new(*_outward(cols["z_lo"], cols["z_hi"]))
@@ -288,6 +288,15 @@ class RangeOnlyResult:
     @property
     def consistent(self) -> bool:
         return not self.empty
+
+    def __repr__(self) -> str:
+        """Counts and summary numbers, not the tubes (the fields hold them)."""
+        d = self.position_diagonal()
+        mean = f"{float(np.mean(d)):.3g}" if d.size and not self.empty else "nan"
+        return (f"RangeOnlyResult(measurements={len(self.meas)}, slices={self.x.n_slices}, "
+                f"consistent={self.consistent}, converged={self.converged}, "
+                f"iterations={self.iterations}, time_s={self.time_s:.3g}, "
+                f"mean_diagonal={mean})")
 
     def position_diagonal(self) -> NDArray[np.float64]:
         """``d`` at every gate: the diagonal of the position box ``[x1] x [x2]``."""

@@ -29,7 +29,7 @@ from ..expr import Model, VarFamily
 from ..expr.functions import sqrt
 from ..expr.tape import Tape, compile_model
 from ..interval import Interval
-from ._data import DataError, embedded, read_csv
+from ._data import check_index, embedded, read_csv
 
 __all__ = [
     "DELTA",
@@ -52,7 +52,8 @@ NOISE = 0.1
 X0_TRUE = (4.0, 0.5, -0.2, 0.5)
 #: Sign restrictions of Remark 2 on x(0).
 X0_DOMAINS = ((0.0, np.inf), (0.0, np.inf), (-np.inf, 0.0), (0.0, np.inf))
-_COLUMNS = ["k", "y1_lo", "y1_hi", "y2_lo", "y2_hi", "y3_lo", "y3_hi"]
+#: CSV columns and their kinds: an output bound may be infinite (an output not measured at k)
+_COLUMNS = {"k": "finite", **{f"y{i}_{s}": s for i in (1, 2, 3) for s in ("lo", "hi")}}
 
 
 @dataclass
@@ -67,27 +68,30 @@ class Measurements:
     def k_max(self) -> int:
         return len(self.y_lo) - 1
 
+    def __repr__(self) -> str:
+        """The size and source, not the data (``y_lo``, ``y_hi`` hold them)."""
+        return f"Measurements(k_max={self.k_max}, source={self.source!r})"
+
 
 def load(path: str | Path | None = None, k_max: int | None = None) -> Measurements:
     """Read measurements (default: the embedded ``satellite_k200.csv`` or ``_k800`` file).
 
-    ``k`` must run 0, 1, ..., without gaps; ``k_max`` (if given) truncates the data and must not
-    exceed what the file holds.
+    Columns ``k, y1_lo, y1_hi, y2_lo, y2_hi, y3_lo, y3_hi`` (no others); ``k`` must run 0, 1,
+    ..., without gaps or repeats; an output bound may be ``-inf``/``inf`` (that output is not
+    measured at ``k``). ``k_max`` (if given) truncates the data and must not exceed what the
+    file holds.
     """
     if path is None:
         path = embedded("satellite_k800.csv" if (k_max or 200) > 200 else "satellite_k200.csv")
     cols = read_csv(path, _COLUMNS)
+    check_index(cols, "k", 0)
     k = cols["k"]
-    expected = np.arange(len(k), dtype=float)
-    if not np.array_equal(k, expected):
-        j = int(np.nonzero(k != expected)[0][0])
-        raise DataError(f"{path}:{j + 2}: k = {float(k[j])!r}, expected {j} (k must run 0, 1, "
-                        "2, ...)")
     y_lo = np.stack([cols[f"y{i}_lo"] for i in (1, 2, 3)], axis=1)
     y_hi = np.stack([cols[f"y{i}_hi"] for i in (1, 2, 3)], axis=1)
     if k_max is not None:
         if not 1 <= k_max <= len(k) - 1:
-            raise DataError(f"{path}: k_max = {k_max} but the file holds k = 0..{len(k) - 1}")
+            raise cols.error(len(k) - 1, f"the file ends at k = {len(k) - 1}, but k_max = "
+                                         f"{k_max} was asked")
         y_lo, y_hi = y_lo[: k_max + 1], y_hi[: k_max + 1]
     return Measurements(y_lo, y_hi, str(path))
 
@@ -128,14 +132,20 @@ def simulate(k_max: int, x0: tuple[float, ...] = X0_TRUE, seed: int | None = 0,
 
 
 def _scaled_outputs(meas: Measurements, beta: float) -> tuple[np.ndarray, np.ndarray]:
-    """Output intervals ``mid + beta ([y] - mid)``, rounded outward (beta >= 1 keeps the data)."""
-    mid = 0.5 * (meas.y_lo + meas.y_hi)
-    rad = 0.5 * (meas.y_hi - meas.y_lo)
+    """Output intervals ``mid + beta ([y] - mid)``, rounded outward (beta >= 1 keeps the data).
+
+    An interval with an infinite bound has no midpoint: it is kept as it is.
+    """
+    bounded = np.isfinite(meas.y_lo) & np.isfinite(meas.y_hi)
+    lo = np.where(bounded, meas.y_lo, 0.0)
+    hi = np.where(bounded, meas.y_hi, 0.0)
+    mid = 0.5 * (lo + hi)
+    rad = 0.5 * (hi - lo)
     ylo = np.nextafter(mid - beta * rad, -np.inf)
     yhi = np.nextafter(mid + beta * rad, np.inf)
     if beta >= 1:
-        ylo, yhi = np.minimum(ylo, meas.y_lo), np.maximum(yhi, meas.y_hi)
-    return ylo, yhi
+        ylo, yhi = np.minimum(ylo, lo), np.maximum(yhi, hi)
+    return np.where(bounded, ylo, meas.y_lo), np.where(bounded, yhi, meas.y_hi)
 
 
 def build_model(meas: Measurements, beta: float = 1.0, w_bound: float = W_BOUND) -> Model:
@@ -171,6 +181,13 @@ def build_model(meas: Measurements, beta: float = 1.0, w_bound: float = W_BOUND)
     return m
 
 
+def _domain_text(lo: float, hi: float) -> str:
+    """A domain in the model text format: ``[lo, hi]``, ``]-oo, hi]``, ``[lo, +oo[``."""
+    a = "]-oo" if lo == -np.inf else f"[{float(lo)!r}"
+    b = "+oo[" if hi == np.inf else f"{float(hi)!r}]"
+    return f"{a}, {b}"
+
+
 def model_text(meas: Measurements) -> str:
     """The same CSP in the model text format (RealPaver-like, seed 000 section 4)."""
     K = meas.k_max
@@ -182,8 +199,7 @@ def model_text(meas: Measurements) -> str:
     for k in range(K + 1):
         decl += [f"  w{i}_{k} in [-{W_BOUND!r}, {W_BOUND!r}]" for i in (1, 2, 3, 4)]
         for i in (1, 2, 3):
-            lo, hi = float(meas.y_lo[k, i - 1]), float(meas.y_hi[k, i - 1])
-            decl.append(f"  y{i}_{k} in [{lo!r}, {hi!r}]")
+            decl.append(f"  y{i}_{k} in {_domain_text(meas.y_lo[k, i - 1], meas.y_hi[k, i - 1])}")
         decl += [f"  x{i}_{k + 1} in ]-oo, +oo[" for i in (1, 2, 3, 4)]
     lines.append(",\n".join(decl) + ";")
     lines.append("Constraints")
@@ -216,8 +232,10 @@ class SatelliteResult:
     beta: float = 1.0
 
     def to_json(self) -> dict:
+        """The fields of ``boundest run satellite --json`` (floats may be infinite or NaN:
+        ``boundest.commands.jsonable`` writes them)."""
         def rows(a: np.ndarray) -> list:
-            return [[None if np.isnan(v) else float(v) for v in r] for r in a]
+            return np.asarray(a, dtype=float).tolist()
 
         return {"scenario": "satellite", "k_max": self.k_max, "consistent": self.consistent,
                 "iterations": self.iterations, "evaluations": self.evaluations,
@@ -227,6 +245,15 @@ class SatelliteResult:
 
     def box(self, k: int) -> Interval:
         return Interval._new(self.x_lo[k], self.x_hi[k])
+
+    def __repr__(self) -> str:
+        """Counts and mean widths, not the enclosures (``x_lo``, ``x_hi`` hold them)."""
+        with np.errstate(invalid="ignore"):
+            w = np.nanmean(self.x_hi - self.x_lo, axis=0) if self.consistent else []
+        widths = ", ".join(f"{v:.3g}" for v in w)
+        return (f"SatelliteResult(k_max={self.k_max}, consistent={self.consistent}, "
+                f"beta={self.beta:g}, evaluations={self.evaluations}, "
+                f"time_s={self.time_s:.3g}, mean_widths=[{widths}])")
 
 
 def _state_names(K: int) -> list[list[str]]:
