@@ -247,6 +247,19 @@ def test_model_file_with_a_byte_order_mark(tmp_path, capsys):
     assert "consistent" in capsys.readouterr().out
 
 
+def test_load_model_reads_like_solve(tmp_path):
+    """The library's ``load_model`` decodes as ``boundest solve`` does."""
+    from boundest.expr import load_model
+    from boundest.expr.parser import ModelSyntaxError
+
+    f = tmp_path / "m.txt"
+    f.write_bytes(b"\xef\xbb\xbf" + GOOD.encode())
+    assert load_model(f).domains
+    f.write_bytes(GOOD.encode("utf-16"))
+    with pytest.raises(ModelSyntaxError, match=f"{f}:1: UTF-16"):
+        load_model(f)
+
+
 def test_errors_from_a_real_process(tmp_path):
     """The console script itself: exit code 2, one line on stderr, no traceback."""
     bad = tmp_path / "bad.csv"

@@ -63,3 +63,16 @@ def test_scenario_result_reprs_are_short():
 
     r = ro.solve(dt=0.5, max_iter=2, progress=False)
     assert len(repr(r)) < 300 and "measurements=11" in repr(r)
+
+
+def test_network_report_repr_is_short():
+    from boundest.tube import ContractorNetwork, CtcDeriv, Tube
+
+    x = Tube.constant(0, 1, 10, Interval.entire())
+    x.gates[0] = Interval(0, 0)
+    cn = ContractorNetwork()
+    cn.add(CtcDeriv(), [x, Tube.constant(0, 1, 10, Interval(-1, 1))])
+    report = cn.contract(rel_eps=0.0, max_iter=500, progress=False)
+    report.contraction += [0.5] * 10**5  # as long as a run with a huge max_iter
+    text = repr(report)
+    assert len(text) < 200 and text.startswith(f"NetworkReport(iterations={report.iterations}")

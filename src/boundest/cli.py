@@ -42,10 +42,9 @@ def _demo(args: argparse.Namespace) -> int:
 
 def _solve(args: argparse.Namespace) -> int:
     from .csp import propagate
-    from .expr.parser import parse_model
-    from .scenarios._data import read_text
+    from .expr import load_model
 
-    model = parse_model(read_text(args.file), source=str(args.file))
+    model = load_model(args.file)
     for key, value in model.options.items():
         print(f"note: option '{key} {value}' is not used by boundest")
     res = propagate(model, rel_eps=args.rel_eps)

@@ -38,6 +38,7 @@ import numpy as np
 from lark import Lark, Token, Transformer, v_args
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, VisitError
 
+from .._textfile import read_text
 from ..interval import Interval
 from .model import Model
 from .nodes import Const, Constraint, Op, Var, power
@@ -395,12 +396,14 @@ def parse_model(text: str, source: str = "<string>") -> Model:
 
 
 def load_model(path: str | Path) -> Model:
-    """Read and parse a model file."""
-    p = Path(path)
-    try:
-        text = p.read_text()
-    except OSError as exc:
-        raise ValueError(f"cannot read model file {p}: {exc.strerror}") from None
-    return parse_model(text, source=str(p))
+    """Read and parse a model file (UTF-8, a byte-order mark accepted).
+
+    Raises
+    ------
+    ModelSyntaxError
+        For an unreadable, UTF-16, non-UTF-8 or binary file, or malformed text; the message
+        names the file and line.
+    """
+    return parse_model(read_text(path, ModelSyntaxError), source=str(path))
 
 

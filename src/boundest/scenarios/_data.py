@@ -33,6 +33,8 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from .._textfile import read_text as _read_text
+
 __all__ = ["KINDS", "DataError", "Table", "check_index", "check_sorted", "embedded", "read_csv",
            "read_text"]
 
@@ -54,34 +56,9 @@ def embedded(name: str) -> Path:
 
 
 def read_text(path: str | Path) -> str:
-    """The text of a UTF-8 file (an initial byte-order mark is dropped).
-
-    Raises
-    ------
-    DataError
-        If the file cannot be read, is UTF-16, is not valid UTF-8 or holds a NUL character (a
-        binary file); the message names the file and the line.
-    """
-    path = Path(path)
-    try:
-        data = path.read_bytes()
-    except OSError as exc:
-        raise DataError(f"{path}: cannot read: {exc.strerror}") from None
-    if data.startswith((b"\xff\xfe", b"\xfe\xff")):
-        raise DataError(f"{path}:1: UTF-16 text (byte-order mark {data[:2].hex(' ')}); "
-                        "save it as UTF-8")
-    try:
-        text = data.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        line = data.count(b"\n", 0, exc.start) + 1
-        raise DataError(f"{path}:{line}: not UTF-8 text (byte 0x{data[exc.start]:02x} at "
-                        f"offset {exc.start}; a binary file?)") from None
-    nul = text.find("\0")
-    if nul >= 0:
-        line = text.count("\n", 0, nul) + 1
-        raise DataError(f"{path}:{line}: NUL character at offset {nul} (a binary or UTF-16 "
-                        "file?)")
-    return text
+    """The text of a UTF-8 file (a byte-order mark is dropped); :class:`DataError` naming the
+    file and line for an unreadable, UTF-16, non-UTF-8 or binary file."""
+    return _read_text(path, DataError)
 
 
 @dataclass

@@ -29,7 +29,7 @@ class TubeContractor(Protocol):
     def contract(self, *domains: Any) -> Any: ...
 
 
-@dataclass
+@dataclass(repr=False)
 class NetworkReport:
     """What a call to :meth:`ContractorNetwork.contract` did.
 
@@ -44,6 +44,11 @@ class NetworkReport:
     empty: bool = False
     converged: bool = False
     time_s: float = 0.0
+
+    def __repr__(self) -> str:
+        last = f"{self.contraction[-1]:.3g}" if self.contraction else "none"
+        return (f"NetworkReport(iterations={self.iterations}, converged={self.converged}, "
+                f"empty={self.empty}, last_contraction={last}, time_s={self.time_s:.3g})")
 
 
 class ContractorNetwork:
