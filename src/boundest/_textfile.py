@@ -5,13 +5,16 @@ Shared by every reader of user files (model text, CSV data): it sits below all l
 
 from __future__ import annotations
 
+import gzip
+import zlib
 from pathlib import Path
 
 __all__ = ["read_text"]
 
 
 def read_text(path: str | Path, error: type[ValueError] = ValueError) -> str:
-    """The text of a UTF-8 file (an initial byte-order mark is dropped).
+    """The text of a UTF-8 file (an initial byte-order mark is dropped); a ``.gz`` file is
+    decompressed first.
 
     Raises
     ------
@@ -24,6 +27,11 @@ def read_text(path: str | Path, error: type[ValueError] = ValueError) -> str:
         data = path.read_bytes()
     except OSError as exc:
         raise error(f"{path}: cannot read: {exc.strerror}") from None
+    if path.suffix == ".gz":
+        try:
+            data = gzip.decompress(data)
+        except (OSError, EOFError, zlib.error) as exc:
+            raise error(f"{path}: not a gzip file, or a truncated one: {exc}") from None
     if data.startswith((b"\xff\xfe", b"\xfe\xff")):
         raise error(f"{path}:1: UTF-16 text (byte-order mark {data[:2].hex(' ')}); "
                     "save it as UTF-8")
