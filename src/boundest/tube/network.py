@@ -2,9 +2,10 @@
 
 Domains are mutable: tubes are contracted in place by their contractors, intervals and boxes
 have their bound arrays overwritten. The network applies every contractor in the order they were
-added, once per iteration, until the relative decrease of the total width of all domains in an
-iteration falls below ``rel_eps`` (with no domain losing an infinite bound), or ``max_iter``
-iterations ran, or a domain became empty.
+added, once per iteration, until no domain's total width decreases by more than ``rel_eps``
+(relative) in an iteration and no infinite bound became finite, or ``max_iter`` iterations
+ran, or a domain became empty. The rule is per domain: a small box (a landmark, a measurement
+time) that still shrinks keeps the network going even beside a long tube that no longer does.
 """
 
 from __future__ import annotations
@@ -33,9 +34,10 @@ class TubeContractor(Protocol):
 class NetworkReport:
     """What a call to :meth:`ContractorNetwork.contract` did.
 
-    ``contraction[k]`` is the relative decrease of the total finite width over iteration ``k``
-    (widths of the slices times their durations for tubes, plus the gates' and intervals'
-    widths), ``newly_bounded[k]`` the number of bounds that stopped being infinite.
+    ``contraction[k]`` is the largest relative decrease, over the domains, of a domain's total
+    finite width in iteration ``k`` (for a tube: the widths of its slices times their durations
+    plus its gates' widths; for an interval or box: its widths), ``newly_bounded[k]`` the
+    number of bounds that stopped being infinite.
     """
 
     iterations: int = 0
@@ -92,19 +94,20 @@ class ContractorNetwork:
                 seen.setdefault(id(d), d)
         return list(seen.values())
 
-    def _widths(self) -> np.ndarray:
-        """Widths of all slices (times their durations), gates and intervals: a measure for
-        the stopping rule only (rounded to nearest; NaN for empty sets)."""
+    def _widths(self) -> list[np.ndarray]:
+        """Widths of each domain: slices (times their durations) and gates of a tube, the
+        bounds of an interval; a measure for the stopping rule only (rounded to nearest; NaN
+        for empty sets)."""
         parts = []
         with np.errstate(invalid="ignore"):
             for d in self.domains:
                 if isinstance(d, Tube):
                     w = (d.slices.hi - d.slices.lo).reshape(d.n_slices, -1)
-                    parts += [(w * np.diff(d.t)[:, None]).ravel(),
-                              (d.gates.hi - d.gates.lo).ravel()]
+                    parts.append(np.concatenate([(w * np.diff(d.t)[:, None]).ravel(),
+                                                 (d.gates.hi - d.gates.lo).ravel()]))
                 else:
                     parts.append(np.atleast_1d(d.hi - d.lo).ravel())
-        return np.concatenate(parts) if parts else np.zeros(0)
+        return parts
 
     def contract_once(self) -> bool:
         """Apply every contractor once; ``False`` as soon as a domain is empty."""
@@ -156,11 +159,14 @@ class ContractorNetwork:
                     break
                 after = self._widths()
                 # widths only shrink: what was finite stays finite (or becomes NaN: empty)
-                fin_b, fin_a = np.isfinite(before), np.isfinite(after)
-                vb = float(np.sum(before, where=fin_b))
-                va = float(np.sum(after, where=fin_b))
-                ratio = (vb - va) / vb if vb > 0 else 0.0
-                bounded = int(np.count_nonzero(fin_a)) - int(np.count_nonzero(fin_b))
+                ratio, bounded = 0.0, 0
+                for wb, wa in zip(before, after, strict=True):
+                    fin_b = np.isfinite(wb)
+                    vb = float(np.sum(wb, where=fin_b))
+                    va = float(np.sum(wa, where=fin_b))
+                    if vb > 0:
+                        ratio = max(ratio, (vb - va) / vb)
+                    bounded += int(np.count_nonzero(np.isfinite(wa))) - int(np.count_nonzero(fin_b))
                 report.contraction.append(ratio)
                 report.newly_bounded.append(bounded)
                 bar.set_postfix(contraction=f"{ratio:.2e}")
