@@ -22,9 +22,9 @@ the truth but are not centred on it.
 
 Examples
 --------
->>> data, truth = simulate_survey(seed=1, n_samples=3000)
->>> data.n, truth.p.shape
-(3000, 3)
+>>> data, truth = simulate_survey(seed=1, n_samples=3000, n_legs=2)
+>>> data.n, truth.p.shape, data.det_k.size > 0
+(3000, (3000, 3), True)
 >>> bool(data.attitude.contains(truth.attitude).all())
 True
 """
