@@ -208,8 +208,10 @@ def simulate_survey(seed: int = 0, n_samples: int = 6000, dt: float = 0.1, t0: f
         ``leg_spacing`` between them). The legs share the time left after the surface phases
         (20 s at each end), the dive and the ascent (30 s each) and the turns.
     n_mines : int
-        Number of mines, each seen 1 to 3 times from starboard (first from an outbound leg,
-        then from the next leg when it passes the mine on starboard too).
+        Number of mines, each seen from starboard first from an outbound leg, then from the
+        next leg, which passes the mine on starboard too. A mine is given 1 to 3 sightings at
+        random, cut to the passes that see it: without a tie line only these two legs do, so
+        in practice a mine is seen once or twice.
     speed : float
         Speed through the water (m/s); the tidal current (0.1-0.2 m/s) adds to it.
     survey_depth : float
@@ -287,7 +289,7 @@ def simulate_survey(seed: int = 0, n_samples: int = 6000, dt: float = 0.1, t0: f
     inc = step(att[:-1], vel[:-1], dt)
     p = integrate(p0, inc)
 
-    # seabed: a gentle plane plus an undulation, gradient at most 0.0045 < 0.005
+    # seabed: a gentle plane plus an undulation, gradient at most 0.0038 < 0.005
     centre = p[:, :2].mean(axis=0)
     grad = 0.002 * np.array([np.cos(a := rng.uniform(0, 2 * np.pi)), np.sin(a)])
     wave_dir = rng.uniform(0, 2 * np.pi)
