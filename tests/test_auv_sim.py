@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import time
 from functools import cache
 
 import numpy as np
@@ -193,10 +192,3 @@ def test_no_mines_and_too_short():
     assert data.det_k.size == 0 and truth.mines.shape == (0, 3)
     with pytest.raises(ValueError, match="too few"):
         simulate_survey(n_samples=2000)
-
-
-def test_fast():
-    simulate_survey(seed=2, n_samples=60000)  # warm up
-    start = time.perf_counter()
-    simulate_survey(seed=2, n_samples=60000)
-    assert time.perf_counter() - start < 2.0

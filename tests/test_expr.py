@@ -968,3 +968,15 @@ def test_boundary_literals():
                  "8" * 300, "4.9406564584124654e-324", "2.4703282292062327e-324",
                  "2.2250738585072014e-308", "9007199254740993", "0.1", "-0.3"):
         reference_check(text, decimal_interval(text))
+
+
+def test_interval_operands_defer_to_expressions_and_tubes():
+    from boundest.tube import Tube
+
+    x = Var("x")
+    c = Interval(0, 1)
+    for e in (c * x, c + x, c - x, c / x):
+        assert isinstance(e, Op) and "[0.0, 1.0]" in str(e)
+    assert str(c * x) == "[0.0, 1.0] * x"
+    y = Interval(1, 2) * Tube.constant(0, 1, 2, Interval(0, 1))
+    assert isinstance(y, Tube) and float(y.slices.hi[0]) == 2.0

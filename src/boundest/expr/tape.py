@@ -26,7 +26,7 @@ from ..interval import Interval
 from .model import Model
 from .nodes import BINARY, UNARY, Const, Constraint, Expr, Op, Var
 
-__all__ = ["OPS", "Tape", "compile_model"]
+__all__ = ["OPS", "Tape", "compile_model", "instantiate"]
 
 #: Op codes: the index of a primitive's name in this tuple.
 OPS: tuple[str, ...] = UNARY + BINARY
@@ -239,3 +239,83 @@ def _close(bld: _Builder, merges: list[tuple[int, int]]) -> Tape:
     return Tape(lo=lo, hi=hi, slot_of=slot_of, op=arr[:, 0].astype(np.int32),
                 out=arr[:, 1].astype(np.int32), a=arr[:, 2].astype(np.int32),
                 b=arr[:, 3].astype(np.int32), param=arr[:, 4].copy())
+
+
+def instantiate(names: list[str], lo: NDArray[np.float64], hi: NDArray[np.float64],
+                pieces: list[tuple[Tape, dict[str, NDArray[np.intp]]]]) -> Tape:
+    """One tape from templates repeated over many index tuples, without compiling each copy.
+
+    A CSP that repeats the same constraints (a time step of a dynamical model, one
+    measurement) is compiled once as a small template tape; this function lays out ``m``
+    copies of each template with NumPy, the template's variables placed on global variables
+    and every other slot of the template (constants, intermediates) fresh in each copy, so each
+    copy is exactly what ``compile_model`` makes of that copy alone (an interval constant stays
+    one independent value per occurrence).
+
+    Parameters
+    ----------
+    names : list of str
+        The global variables (slots ``0 .. len(names) - 1`` of the result).
+    lo, hi : array, shape (len(names),)
+        Their initial domains (intersected with the domains the templates give them).
+    pieces : list of (Tape, dict)
+        Each template with its placement: template variable name -> int array ``(m,)`` of the
+        global variable that copy ``i`` puts there (one ``m`` per template). The nodes of copy
+        ``i`` follow those of copy ``i - 1``.
+
+    Examples
+    --------
+    >>> from boundest.expr import Var
+    >>> step = compile_model([Var("y") == 0.5 * Var("x")])
+    >>> t = instantiate(["x0", "x1", "x2"], np.array([4.0, -np.inf, -np.inf]),
+    ...                 np.array([4.0, np.inf, np.inf]),
+    ...                 [(step, {"x": np.array([0, 1]), "y": np.array([1, 2])})])
+    >>> t.n_nodes, t.slot_of["x2"]
+    (2, 2)
+    """
+    n = len(names)
+    lo, hi = np.array(lo, dtype=np.float64), np.array(hi, dtype=np.float64)
+    if lo.shape != (n,) or hi.shape != (n,):
+        raise ValueError(f"lo and hi must have shape ({n},), got {lo.shape} and {hi.shape}")
+    slot_lo, slot_hi = [lo], [hi]
+    ops, outs, as_, bs, params = [], [], [], [], []
+    nxt = n
+    for tape, place in pieces:
+        var_slots = {tape.slot_of[v] for v in tape.slot_of}
+        if set(place) != set(tape.slot_of):
+            raise ValueError(f"placement names {sorted(place)} differ from the template's "
+                             f"variables {sorted(tape.slot_of)}")
+        if len(var_slots) != len(tape.slot_of):
+            raise ValueError("a template must not merge two of its variables into one slot")
+        sizes = {np.asarray(p).shape for p in place.values()}
+        if len(sizes) != 1 or len(next(iter(sizes))) != 1:
+            raise ValueError(f"placements must be 1-D arrays of one length, got shapes {sizes}")
+        m = next(iter(sizes))[0]
+        private = np.array([s for s in range(tape.n_slots) if s not in var_slots], dtype=np.intp)
+        where = np.empty((m, tape.n_slots), dtype=np.int64)
+        for v, s in tape.slot_of.items():
+            g = np.asarray(place[v], dtype=np.int64)
+            if g.size and (g.min() < 0 or g.max() >= n):
+                raise ValueError(f"placement of {v!r} outside the {n} global variables")
+            where[:, s] = g
+            np.maximum.at(lo, g, tape.lo[s])  # the template's domain of the variable
+            np.minimum.at(hi, g, tape.hi[s])
+        q = private.size
+        where[:, private] = nxt + np.arange(m * q, dtype=np.int64).reshape(m, q)
+        nxt += m * q
+        slot_lo.append(np.tile(tape.lo[private], m))
+        slot_hi.append(np.tile(tape.hi[private], m))
+        ops.append(np.tile(tape.op, m))
+        outs.append(where[:, tape.out].ravel())
+        as_.append(where[:, tape.a].ravel())
+        bs.append(np.where(tape.b >= 0, where[:, np.maximum(tape.b, 0)], -1).ravel())
+        params.append(np.tile(tape.param, m))
+    all_lo, all_hi = np.concatenate(slot_lo), np.concatenate(slot_hi)
+    if nxt >= 2**31:
+        raise ValueError(f"{nxt} slots exceed the tape's int32 slot numbers")
+    empty = np.isnan(all_lo) | np.isnan(all_hi) | (all_lo > all_hi)
+    all_lo[empty] = all_hi[empty] = np.nan
+    return Tape(lo=all_lo, hi=all_hi, slot_of={v: i for i, v in enumerate(names)},
+                op=np.concatenate(ops).astype(np.int32), out=np.concatenate(outs).astype(np.int32),
+                a=np.concatenate(as_).astype(np.int32), b=np.concatenate(bs).astype(np.int32),
+                param=np.concatenate(params))

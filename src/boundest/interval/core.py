@@ -377,28 +377,28 @@ class Interval:
         return Interval._new(-self.hi, -self.lo)
 
     def __add__(self, other: Any) -> Interval:
-        return _arith.add(self, other)
+        return NotImplemented if _defers(other) else _arith.add(self, other)
 
     def __radd__(self, other: Any) -> Interval:
-        return _arith.add(other, self)
+        return NotImplemented if _defers(other) else _arith.add(other, self)
 
     def __sub__(self, other: Any) -> Interval:
-        return _arith.sub(self, other)
+        return NotImplemented if _defers(other) else _arith.sub(self, other)
 
     def __rsub__(self, other: Any) -> Interval:
-        return _arith.sub(other, self)
+        return NotImplemented if _defers(other) else _arith.sub(other, self)
 
     def __mul__(self, other: Any) -> Interval:
-        return _arith.mul(self, other)
+        return NotImplemented if _defers(other) else _arith.mul(self, other)
 
     def __rmul__(self, other: Any) -> Interval:
-        return _arith.mul(other, self)
+        return NotImplemented if _defers(other) else _arith.mul(other, self)
 
     def __truediv__(self, other: Any) -> Interval:
-        return _arith.div(self, other)
+        return NotImplemented if _defers(other) else _arith.div(self, other)
 
     def __rtruediv__(self, other: Any) -> Interval:
-        return _arith.div(other, self)
+        return NotImplemented if _defers(other) else _arith.div(other, self)
 
     def __pow__(self, other: Any) -> Interval:
         from . import explog
@@ -407,6 +407,13 @@ class Interval:
     def __abs__(self) -> Interval:
         from . import algebraic
         return algebraic.abs(self)
+
+
+def _defers(x: Any) -> bool:
+    """Whether ``x`` is a non-interval object that asks NumPy-style operands to defer to its
+    reflected operators (``__array_ufunc__ = None``: expressions, tubes), so that
+    ``Interval(0, 1) * expr`` builds an expression as ``expr * Interval(0, 1)`` does."""
+    return not isinstance(x, Interval) and getattr(type(x), "__array_ufunc__", 0) is None
 
 
 def as_interval(x: ArrayLike | Interval) -> Interval:

@@ -20,15 +20,16 @@ its mean-value (centred) form, computed over all samples at once.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import NDArray
 
 from .. import interval as iv
-from ..ctc import CtcFwdBwd
+from ..csp import propagate
 from ..expr import Var
 from ..expr.functions import cos, sin
+from ..expr.tape import compile_model, instantiate
 from ..interval import Interval
 from ..tube import ContractorNetwork, CtcDeriv, NetworkReport, Tube
 from .auv_data import AuvData
@@ -150,45 +151,57 @@ class CtcDetections:
 
     ``contract(p, attitude, altitude, mines)`` contracts, in place, the gates of the position
     tube ``p`` at the detection samples, the attitude ``(n, 3)`` and altitude ``(n,)`` boxes at
-    those samples and the mine boxes ``(n_mines, 3)``: the constraints of every detection run as
-    one batch (``CtcFwdBwd``, repeated ``passes`` times), then the contracted copies of each
-    mine are intersected.
+    those samples and the mine boxes ``(n_mines, 3)``. The constraints of all detections form
+    one CSP (each detection a copy of ``detection_constraints``, the copies of a mine sharing
+    its variables), propagated to its fixed point at ``rel_eps`` by
+    :func:`boundest.csp.propagate`.
     """
 
-    def __init__(self, data: AuvData, passes: int = 3) -> None:
-        self.k = data.det_k
-        self.mine = data.det_mine
-        self.range = data.det_range
-        self.passes = passes
-        self.ctc = CtcFwdBwd(detection_constraints(data.seabed_tol), list(DETECTION_VARS))
+    def __init__(self, data: AuvData, rel_eps: float = 1e-9) -> None:
+        self.k, self.mine, self.rel_eps = data.det_k, data.det_mine, rel_eps
+        nd, nm = self.k.size, data.n_mines
+        # variables: per detection p (3), attitude (3), a, r, alpha; then the mines (3 each)
+        per = 9
+        d = np.arange(nd)
+        place = {v: per * d + i for i, v in enumerate(("px", "py", "pz", "phi", "theta", "psi",
+                                                       "a", "r", "alpha"))}
+        for i, c in enumerate("xyz"):
+            place[f"m{c}"] = per * nd + 3 * self.mine + i
+        self.n_vars = per * nd + 3 * nm
+        names = [f"v{i}" for i in range(self.n_vars)]
+        lo, hi = np.full(self.n_vars, -np.inf), np.full(self.n_vars, np.inf)
+        lo[place["r"]], hi[place["r"]] = data.det_range.lo, data.det_range.hi
+        template = compile_model(detection_constraints(data.seabed_tol))
+        self.tape = instantiate(names, lo, hi, [(template, place)])
+        self.per, self.nm = per, nm
 
     def contract(self, p: Tube, attitude: Interval, altitude: Interval,
                  mines: Interval) -> None:
-        k, j = self.k, self.mine
-        g = p.gates[k]
-        alpha = Interval.entire((k.size, 1))
-        parts = [g, attitude[k], altitude[k][:, None], mines[j], self.range[:, None], alpha]
-        box = Interval._new(np.concatenate([q.lo for q in parts], axis=1),
-                            np.concatenate([q.hi for q in parts], axis=1))
-        for _ in range(self.passes):
-            box = self.ctc(box)
-        if np.isnan(box.lo).any():
+        k, nd, per = self.k, self.k.size, self.per
+        lo, hi = self.tape.lo.copy(), self.tape.hi.copy()
+        rows = Interval._new(lo[: per * nd].reshape(nd, per), hi[: per * nd].reshape(nd, per))
+        for cols, dom in ((slice(0, 3), p.gates[k]), (slice(3, 6), attitude[k]),
+                          (slice(6, 7), altitude[k][:, None])):
+            cut = rows[:, cols] & dom
+            rows.lo[:, cols], rows.hi[:, cols] = cut.lo, cut.hi
+        lo[: per * nd], hi[: per * nd] = rows.lo.ravel(), rows.hi.ravel()
+        mv = slice(per * nd, self.n_vars)
+        m = Interval._new(lo[mv], hi[mv]) & mines.reshape(-1)
+        lo[mv], hi[mv] = m.lo, m.hi
+        res = propagate(replace(self.tape, lo=lo, hi=hi), rel_eps=self.rel_eps, progress=False)
+        if not res.consistent:
             p.set_empty()
-            for d in (attitude, altitude, mines):
-                d.lo[...] = d.hi[...] = np.nan
+            for dom in (attitude, altitude, mines):
+                dom.lo[...] = dom.hi[...] = np.nan
             return
-        p.gates[k] = box[:, 0:3]
-        attitude[k] = box[:, 3:6]
-        altitude[k] = box[:, 6]
-        m = box[:, 7:10]
-        lo = np.full(mines.shape, -np.inf)
-        hi = np.full(mines.shape, np.inf)
-        np.maximum.at(lo, j, m.lo)
-        np.minimum.at(hi, j, m.hi)
-        new = mines & Interval._new(lo, hi)
-        mines.lo[...], mines.hi[...] = new.lo, new.hi
-        if np.isnan(mines.lo).any():
-            p.set_empty()
+        out = res.slots
+        rows = Interval._new(out.lo[: per * nd].reshape(nd, per),
+                             out.hi[: per * nd].reshape(nd, per))
+        p.gates[k] = rows[:, 0:3]
+        attitude[k] = rows[:, 3:6]
+        altitude[k] = rows[:, 6]
+        m = out[per * nd: self.n_vars].reshape(self.nm, 3)
+        mines.lo[...], mines.hi[...] = m.lo, m.hi
 
     __call__ = contract
 
