@@ -480,7 +480,7 @@ def test_load_model(tmp_path):
     bad.write_text("x in [0,1];\nConstraints\nx = y;\n")
     with pytest.raises(ModelSyntaxError, match=rf"^{re.escape(str(bad))}:3:5: unknown variable y"):
         load_model(bad)
-    with pytest.raises(ValueError, match="cannot read model file"):
+    with pytest.raises(ValueError, match=r"missing.txt: cannot read"):
         load_model(tmp_path / "missing.txt")
 
 

@@ -45,13 +45,20 @@ class Jumpy:
         return mpmath.mpf(float(self.c[self.piece(s)])) + self.g.deriv(s)
 
     def x(self, s: float) -> mpmath.mpf:
+        """Free of cancellation: ``g(s) - g(t0)`` by the sine difference formula with the exact
+        ``s - t0`` (times differ by as little as 1e-131 from ``t0``, where ``g`` is of order
+        1e-20: subtracting ``g`` values would need more digits than any fixed precision)."""
         s_mp, t0 = mpmath.mpf(s), mpmath.mpf(float(self.tau[0]))
-        out = mpmath.mpf(self.x0) + (self.g.value(s) - self.g.value(float(self.tau[0])))
+        h = mpmath.fsub(s_mp, t0, exact=True)
+        out = mpmath.mpf(self.x0)
+        for a, w, p in zip(self.g.a, self.g.w, self.g.p, strict=True):
+            mid = mpmath.fadd(s_mp, t0, exact=True) / 2
+            out += 2 * a * mpmath.cos(w * mid + p) * mpmath.sin(w * h / 2)
         for k in range(self.c.size):
             a = max(t0, mpmath.mpf(float(self.tau[k])))
             b = min(s_mp, mpmath.mpf(float(self.tau[k + 1])))
             if b > a:
-                out += mpmath.mpf(float(self.c[k])) * (b - a)
+                out += mpmath.mpf(float(self.c[k])) * mpmath.fsub(b, a, exact=True)
         return out
 
     def v_slices(self, t: np.ndarray) -> Interval:
