@@ -298,7 +298,8 @@ def test_the_json_convention():
     ["run", "jaulin2001", "--boxes"],
     ["run", "range-only", "--dt", "0.5", "--max-iter", "3"],
     ["run", "drifting-clock", "--dt", "0.1"],
-], ids=lambda a: " ".join(a[:2]))
+    ["run", "auv", "--mode", "localization"],
+], ids=lambda a: " ".join(a[:3]))
 def test_every_command_writes_strict_json(tmp_path, capsys, argv):
     js = tmp_path / "out.json"
     assert main([*argv, "--out", str(tmp_path), "--json", str(js)]) == 0
