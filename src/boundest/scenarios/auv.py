@@ -75,6 +75,20 @@ def world_velocity(attitude: Interval, velocity: Interval, form: str = "best") -
     """
     if form not in ("best", "natural"):
         raise ValueError(f"form must be 'best' or 'natural', got {form!r}")
+    n = attitude.shape[0]
+    if n > _CHUNK:  # bounded memory: some 70 temporaries per sample
+        parts = [_world_velocity(attitude[i:i + _CHUNK], velocity[i:i + _CHUNK], form)
+                 for i in range(0, n, _CHUNK)]
+        return Interval._new(np.concatenate([q.lo for q in parts]),
+                             np.concatenate([q.hi for q in parts]))
+    return _world_velocity(attitude, velocity, form)
+
+
+#: Samples per block of ``world_velocity``.
+_CHUNK = 8192
+
+
+def _world_velocity(attitude: Interval, velocity: Interval, form: str) -> Interval:
     phi, theta, psi = (attitude[:, i] for i in range(3))
     v = tuple(velocity[:, i] for i in range(3))
     c = _trig(phi, theta, psi)
