@@ -47,7 +47,7 @@ def plot_auv_map(data: AuvData, results: list[AuvResult], truth: AuvTruth | None
         ax.plot([], [], "s", color=colour, alpha=0.6,
                 label=f"position box every {every_s:g} s ({res.mode})")
         mid = res.positions.mid()
-        ax.plot(mid[:, 1], mid[:, 0], color=colour, lw=0.6)
+        ax.plot(mid[:, 1], mid[:, 0], color=colour, lw=0.6, label=f"box centres ({res.mode})")
     f = data.fix
     _rects(ax, np.stack([f.lo[:, 1], f.lo[:, 0]], 1), np.stack([f.hi[:, 1], f.hi[:, 0]], 1),
            facecolor="none", edgecolor=GPS, lw=1.5)
