@@ -88,6 +88,19 @@ def world_velocity(attitude: Interval, velocity: Interval, form: str = "best") -
 _CHUNK = 8192
 
 
+def _matrix(c: dict[str, Interval]) -> list[list[Interval]]:
+    """The entries of ``R = R_psi R_theta R_phi`` multiplied out."""
+    cf, sf, ct, st, cp, sp = (c[k] for k in ("cf", "sf", "ct", "st", "cp", "sp"))
+    sts, stc = st * sf, st * cf
+    return [[cp * ct, cp * sts - sp * cf, cp * stc + sp * sf],
+            [sp * ct, sp * sts + cp * cf, sp * stc - cp * sf],
+            [-st, ct * sf, ct * cf]]
+
+
+def _dot(row: list[Interval], v: tuple[Interval, ...]) -> Interval:
+    return row[0] * v[0] + row[1] * v[1] + row[2] * v[2]
+
+
 def _world_velocity(attitude: Interval, velocity: Interval, form: str) -> Interval:
     phi, theta, psi = (attitude[:, i] for i in range(3))
     v = tuple(velocity[:, i] for i in range(3))
@@ -95,29 +108,38 @@ def _world_velocity(attitude: Interval, velocity: Interval, form: str) -> Interv
     wx, wy, wz, ux, uy, s = _rv(c, v)
     if form == "natural":
         return _stack([wx, wy, wz])
-    # mean-value form: w(X) ⊆ w(m) + J(X) (X - m), J the interval Jacobian over the box
+    # two natural extensions with other dependencies: through the levelled velocity, and with
+    # R written out entry by entry; each is the tighter one on some samples
+    R = _matrix(c)
+    w = [a & _dot(row, v) for a, row in zip((wx, wy, wz), R, strict=True)]
+    # mean-value form: w(X) ⊆ w(m) + J(X) (X - m), J an interval Jacobian over the box, each
+    # entry the intersection of its two forms
     q = (phi, theta, psi, *v)
     mids = [Interval(x.mid()) for x in q]
-    wm = _rv(_trig(*mids[:3]), tuple(mids[3:]))
+    cm = _trig(*mids[:3])
+    vm = tuple(mids[3:])
+    wm = [a & _dot(row, vm) for a, row in zip(_rv(cm, vm)[:3], _matrix(cm), strict=True)]
     dq = [x - m for x, m in zip(q, mids, strict=True)]
-    uz = wz
-    cf, sf, ct, st, cp, sp = (c[k] for k in ("cf", "sf", "ct", "st", "cp", "sp"))
-    # partial derivatives of u = (ux, uy, uz) with respect to phi, theta, vx, vy, vz
-    du = {  # q index -> (dux, duy, duz)
-        0: (st * uy, -s, ct * uy),
-        1: (uz, None, -ux),
-        3: (ct, None, -st),
-        4: (st * sf, cf, ct * sf),
-        5: (st * cf, -sf, ct * cf),
-    }
-    acc_x, acc_y, acc_z = wm[0] - wy * dq[2], wm[1] + wx * dq[2], wm[2]  # d/dpsi: -wy, wx
-    for j, (dux, duy, duz) in du.items():
-        gx, gy = cp * dux, sp * dux
-        if duy is not None:
-            gx, gy = gx - sp * duy, gy + cp * duy
-        acc_x, acc_y, acc_z = acc_x + gx * dq[j], acc_y + gy * dq[j], acc_z + duz * dq[j]
-    out = [wx & acc_x, wy & acc_y, wz & acc_z]
-    return _stack(out)
+    ct, st, cp, sp = c["ct"], c["st"], c["cp"], c["sp"]
+    uz = ct * s - st * v[0]
+    # d/dphi: levelled (cp st uy + sp s, sp st uy - cp s, ct uy), or R[:, 2] vy - R[:, 1] vz
+    # d/dtheta: levelled (cp uz, sp uz, -ux), or (cp, sp, -) times the third row's derivative
+    jac = [
+        [(cp * (st * uy) + sp * s) & (R[0][2] * v[1] - R[0][1] * v[2]),
+         (sp * (st * uy) - cp * s) & (R[1][2] * v[1] - R[1][1] * v[2]),
+         (ct * uy) & (R[2][2] * v[1] - R[2][1] * v[2])],
+        [cp * (uz & w[2]), sp * (uz & w[2]), -ux],
+        [-w[1], w[0], None],
+        [R[0][0], R[1][0], R[2][0]],
+        [R[0][1], R[1][1], R[2][1]],
+        [R[0][2], R[1][2], R[2][2]],
+    ]
+    acc = list(wm)
+    for j, col in enumerate(jac):
+        for i in range(3):
+            if col[i] is not None:
+                acc[i] = acc[i] + col[i] * dq[j]
+    return _stack([a & b for a, b in zip(w, acc, strict=True)])
 
 
 # -- the detection constraints ----------------------------------------------------------------
