@@ -12,7 +12,8 @@ Spec fields: ``n``; ``dt_lo``, ``dt_hi`` (the decimal sampling period enclosed);
 ``depth_lo``, ``depth_hi`` (n); ``fix_k`` (ints); ``fix_lo``, ``fix_hi`` (f x 3: north, east,
 depth); ``repeat`` (runs timed, median reported); optional ``modes`` (a subset of
 ``centered``, ``natural``, ``default``; all three by default) and ``check_recurrence``
-(default true).
+(default true); optional ``positions_modes`` and ``w_modes`` (modes whose position gates
+or world velocities are also written out; none by default).
 
 Model (data set section 1.3): world velocity ``w[k] = R(phi, theta, psi)[k] v[k]`` with
 ``R = R_psi R_theta R_phi``, attitude and body velocity held over each sample, and
@@ -43,7 +44,9 @@ gates), ``w_mean_width``, ``w_max_width`` (of ``w``), ``w_eval_s`` (median) and
 ``w_eval_times_s``, ``tube_build_s`` (median: tdomain, two tubes, slices and gates set),
 ``ctc_deriv_s`` (median of the ``contract`` call) and ``ctc_deriv_times_s``,
 ``recurrence_s``, ``recurrence_times_s``, ``recurrence_max_abs_diff`` (with
-``check_recurrence``).
+``check_recurrence``); ``positions_lo``, ``positions_hi`` for the modes in
+``positions_modes``, ``w_lo``, ``w_hi`` (n x 3, ``w`` itself, not ``dt w``) for those in
+``w_modes``.
 
 Usage::
 
@@ -112,6 +115,8 @@ def main() -> None:
     repeat = max(1, int(spec.get("repeat", 1)))
     modes = spec.get("modes", list(MODES))
     check = bool(spec.get("check_recurrence", True))
+    positions_modes = set(spec.get("positions_modes", []))
+    w_modes = set(spec.get("w_modes", []))
     dt = Interval(spec["dt_lo"], spec["dt_hi"])
     att = list(zip(_rows(spec["att_lo"], 3), _rows(spec["att_hi"], 3), strict=True))
     vel = list(zip(_rows(spec["vel_lo"], 3), _rows(spec["vel_hi"], 3), strict=True))
@@ -226,6 +231,12 @@ def main() -> None:
             rec["recurrence_max_abs_diff"] = max(diff, default=0.0)
             _log(f"codac2 {mode}: recurrence in {rec['recurrence_s']:.3f} s, "
                  f"max |diff| to CtcDeriv {rec['recurrence_max_abs_diff']:.3g}")
+        if mode in positions_modes:
+            rec["positions_lo"] = [_h(v) for row in lo for v in row]
+            rec["positions_hi"] = [_h(v) for row in hi for v in row]
+        if mode in w_modes:
+            rec["w_lo"] = [_h(v) for row in wlo for v in row]
+            rec["w_hi"] = [_h(v) for row in whi for v in row]
         out_modes[mode] = rec
         if mode == "centered":
             positions = (lo, hi)
