@@ -43,6 +43,8 @@ from _subprocess import run_json_script
 ROOT = Path(__file__).resolve().parent.parent
 CODAC_PY = ROOT / ".bench-venv-codac1" / "bin" / "python"
 CODAC_SCRIPT = Path(__file__).resolve().parent / "auv_codac.py"
+CODAC2_PY = ROOT / ".bench-venv-codac2" / "bin" / "python"
+CODAC2_SCRIPT = Path(__file__).resolve().parent / "auv_codac2.py"
 BOUNDEST = Path(sys.executable).with_name("boundest")
 #: Figures quoted by the issue (measured earlier by the team with Codac 1.5.7; not by this run).
 TEAM = {"codac_1.5.7": {
@@ -197,6 +199,39 @@ def main() -> int:
         rec["ratios"] = ratios
     else:
         rec["codac"] = "not run (no .bench-venv-codac1 or --no-codac)"
+    if not args.no_codac and CODAC2_PY.exists():
+        log("codac 2 (localization, per-sample comparison) ...")
+        spec = _codac_spec(data, args.codac_repeat)
+        spec.update(modes=["natural", "centered", "default"], check_recurrence=False,
+                    positions_modes=["default"])
+        c2 = run_json_script(CODAC2_PY, CODAC2_SCRIPT, spec)
+        mine = auv.localize(data)
+        b_loc = mine.widths().mean(axis=0).tolist()
+        comp = {}
+        for mode in ("centered", "default"):
+            rec2 = c2["modes"][mode]
+            if mode == "centered":
+                lo, hi = c2["positions_lo"], c2["positions_hi"]
+            else:
+                lo, hi = rec2["positions_lo"], rec2["positions_hi"]
+            lo = np.array([float.fromhex(x) for x in lo]).reshape(-1, 3)
+            hi = np.array([float.fromhex(x) for x in hi]).reshape(-1, 3)
+            excess = mine.widths() - (hi - lo)
+            comp[mode] = {"samples_wider_per_axis": (excess > 0).sum(axis=0).tolist(),
+                          "max_excess_m": excess.max(axis=0).tolist(),
+                          "mean_width_codac": rec2["mean_width"],
+                          "width_codac_over_boundest": [
+                              a / b for a, b in zip(rec2["mean_width"], b_loc, strict=True)],
+                          "mean_width_boundest": b_loc}
+        for mode in ("natural", "centered", "default"):
+            r2 = c2["modes"][mode]
+            for key in ("positions_lo", "positions_hi", "w_lo", "w_hi"):
+                r2.pop(key, None)
+        c2.pop("positions_lo", None)
+        c2.pop("positions_hi", None)
+        rec["codac2"] = {"run": c2, "localization_vs_boundest": comp}
+    else:
+        rec["codac2"] = "not run (no .bench-venv-codac2 or --no-codac)"
     rec["loadavg_end"] = os.getloadavg()
     rec["children_maxrss_mb"] = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
     text = json.dumps(rec, indent=1, default=float)
