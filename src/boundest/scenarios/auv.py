@@ -13,8 +13,9 @@ in samples: gate ``k`` is sample ``k`` and the derivative per unit of this time 
   ``CtcDeriv`` form one ``ContractorNetwork``, propagated to a fixed point: a mine seen twice
   ties the two parts of the trajectory together, both ways.
 
-The world velocity is enclosed by the natural interval extension of ``R v`` intersected with
-its mean-value (centred) form, computed over all samples at once.
+The world velocity is enclosed by two natural interval extensions of ``R v`` (through the
+levelled velocity, and with ``R`` multiplied out) intersected with a mean-value (centred) form,
+computed over all samples at once.
 """
 
 from __future__ import annotations
@@ -69,9 +70,11 @@ def world_velocity(attitude: Interval, velocity: Interval, form: str = "best") -
     form : {"best", "natural"}
         ``"natural"``: the natural interval extension of ``R v`` written through the levelled
         velocity ``u = R_theta R_phi v`` (``w_x = cos(psi) u_x - sin(psi) u_y``, ...).
-        ``"best"``: that, intersected with the mean-value form around the box centre (the
-        rotation of a box is not a box; the centred form takes the correlation of ``w_x`` and
-        ``w_y`` through ``psi`` into account).
+        ``"best"``: that, intersected with the natural extension of ``R v`` with ``R``
+        multiplied out and with the mean-value form around the box centre (the rotation of a
+        box is not a box; the centred form takes the correlation of ``w_x`` and ``w_y``
+        through ``psi`` into account). It is never wider than Codac 2.1.2's intersection of
+        its natural and centred forms (beyond one ulp; ``benchmarks/bench_auv.py``).
     """
     if form not in ("best", "natural"):
         raise ValueError(f"form must be 'best' or 'natural', got {form!r}")
@@ -303,7 +306,8 @@ def position_tube(data: AuvData) -> Tube:
     x.gates.hi[:, 2] = np.minimum(x.gates.hi[:, 2], data.depth.hi)
     g = x.gates[data.fix_k] & data.fix
     x.gates[data.fix_k] = g
-    x._normalize_empty()
+    if x.is_empty():  # a fix outside the depth boxes
+        x.set_empty()
     return x
 
 
@@ -337,7 +341,7 @@ def slam(data: AuvData, form: str = "best", rel_eps: float = 1e-4, max_iter: int
     to a relative fixed point ``rel_eps``.
 
     The attitude and altitude boxes at the detection samples are contracted too; the world
-    velocity of those samples is then recomputed from them (``CtcWorldVelocity`` below keeps the
+    velocity of those samples is then recomputed from them (``_CtcWorldVelocity`` keeps the
     derivative tube consistent with the contracted attitude).
     """
     start = time.perf_counter()
