@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import sys
 
 import numpy as np
 import pytest
@@ -236,3 +237,17 @@ def test_qinter_boxes_batched_equals_one_by_one(bounds, q, method):
 def test_exported_at_top_level():
     assert bd.qinter is qinter and bd.qinter_boxes is qinter_boxes
     assert "qinter" in bd.__all__ and "qinter_boxes" in bd.__all__
+
+
+@settings(max_examples=60)
+@given(box_sets(max_n_members=6), st.integers(1, 7))
+def test_qinter_boxes_exact_in_chunks_of_subsets(args, chunk):
+    mod = sys.modules["boundest.interval.qinter"]  # the attribute is the function qinter
+    boxes, q = args
+    whole = qinter_boxes(boxes, q, "exact")
+    saved = mod._CHUNK_ELEMENTS
+    mod._CHUNK_ELEMENTS = chunk  # a few subsets (or one) per chunk
+    try:
+        assert np.all(qinter_boxes(boxes, q, "exact") == whole)
+    finally:
+        mod._CHUNK_ELEMENTS = saved

@@ -35,6 +35,9 @@ __all__ = ["EXACT_MAX_SUBSETS", "qinter", "qinter_boxes"]
 #: ``method="auto"`` of ``qinter_boxes`` is exact when ``C(N, q)`` is at most this
 EXACT_MAX_SUBSETS = 256
 
+#: the exact method gathers at most about this many bounds at once (chunks of subsets)
+_CHUNK_ELEMENTS = 1 << 21
+
 Method = Literal["auto", "exact", "projection"]
 
 
@@ -196,18 +199,21 @@ def _exact(lo: NDArray, hi: NDArray, k: int) -> Interval:
 
     A point lies in at least ``k`` boxes exactly when it lies in the intersection of some
     ``k`` of them, so the set is that union and its hull is the hull of the non-empty
-    intersections. Subsets are batched: one gather and one reduction for all of them.
+    intersections. Subsets are batched: one gather and one reduction per chunk of subsets, the
+    chunks sized so that the gathered bounds stay under ``_CHUNK_ELEMENTS`` floats.
     """
     n_members = lo.shape[-2]
-    # keep the C(N, q) subsets small: choose the k kept boxes (C(N, k) = C(N, q))
-    idx = _subsets(n_members, k)  # (C, k)
-    slo = lo[..., idx, :]  # (..., C, k, n)
-    shi = hi[..., idx, :]
-    ilo = slo.max(axis=-2)  # NaN (an empty member) propagates
-    ihi = shi.min(axis=-2)
-    bad = np.isnan(ilo).any(axis=-1) | (ilo > ihi).any(axis=-1)  # (..., C)
-    ilo = np.where(bad[..., None], np.nan, ilo)
-    ihi = np.where(bad[..., None], np.nan, ihi)
-    rlo = np.fmin.reduce(ilo, axis=-2)  # the hull skips the empty intersections
-    rhi = np.fmax.reduce(ihi, axis=-2)
+    idx = _subsets(n_members, k)  # (C, k): the kept boxes; C(N, k) = C(N, q)
+    per_subset = max(1, lo.size // n_members * k)
+    step = max(1, _CHUNK_ELEMENTS // per_subset)
+    rlo = np.full(lo.shape[:-2] + lo.shape[-1:], np.nan)
+    rhi = rlo.copy()
+    for start in range(0, idx.shape[0], step):  # a loop over chunks of subsets, not boxes
+        sub = idx[start:start + step]
+        ilo = lo[..., sub, :].max(axis=-2)  # (..., c, n); NaN (an empty member) propagates
+        ihi = hi[..., sub, :].min(axis=-2)
+        bad = (np.isnan(ilo) | (ilo > ihi)).any(axis=-1, keepdims=True)
+        # the hull skips the empty intersections (fmin/fmax ignore NaN)
+        rlo = np.fmin(rlo, np.fmin.reduce(np.where(bad, np.nan, ilo), axis=-2))
+        rhi = np.fmax(rhi, np.fmax.reduce(np.where(bad, np.nan, ihi), axis=-2))
     return Interval._new(rlo, rhi)
