@@ -11,6 +11,7 @@ from .csp import Arc, BetaResult, Propagation, TreeSCSP, beta_tuning, propagate 
 from .ctc import (  # noqa: F401
     Contractor,
     CtcFwdBwd,
+    CtcQInter,
     Fixpoint,
     FunctionContractor,
     Inflate,
@@ -51,8 +52,9 @@ Box = IntervalVector
 
 __all__ = list(dict.fromkeys([
     *_interval_all, *_functions.__all__, "Box", "__version__", "BetaResult", "Propagation",
-    "beta_tuning", "propagate", "Contractor", "CtcFwdBwd", "Fixpoint", "FunctionContractor",
-    "Inflate", "Sequence", "Union", "Constraint", "Model", "ModelSyntaxError", "Var",
+    "beta_tuning", "propagate", "Contractor", "CtcFwdBwd", "CtcQInter", "Fixpoint",
+    "FunctionContractor", "Inflate", "Sequence", "Union", "Constraint", "Model",
+    "ModelSyntaxError", "Var",
     "VarFamily", "load_model", "parse_model", "Arc", "TreeSCSP", "ChainEstimate",
     "DiscreteSystem", "cse", "ncse", "rcse", "Subpaving", "image", "separators", "sivia",
     "ContractorNetwork", "CtcDeriv", "CtcEval", "CtcSlices", "NetworkReport", "Tube",
