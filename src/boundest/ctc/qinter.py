@@ -7,7 +7,7 @@ from collections.abc import Sequence as Seq
 import numpy as np
 
 from ..interval import Interval, intersect
-from ..interval.qinter import Method, _check_q, qinter_boxes
+from ..interval.relaxed import Method, _check_q, qinter_boxes
 from .base import Contractor, _dimension, _empty_rows
 
 __all__ = ["CtcQInter"]

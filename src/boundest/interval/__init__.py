@@ -13,7 +13,7 @@ from .algebraic import *  # noqa: E402, F403
 from .arith import add, div, mul, neg, recip, sqr, sqrt, sub  # noqa: E402
 from .core import Interval, IntervalVector, as_interval, hull, intersect  # noqa: E402
 from .explog import *  # noqa: E402, F403
-from .qinter import qinter, qinter_boxes  # noqa: E402
+from .relaxed import qinter, qinter_boxes  # noqa: E402
 from .trig import *  # noqa: E402, F403
 
 __all__ = ["Interval", "IntervalVector", "as_interval", "hull", "intersect",
