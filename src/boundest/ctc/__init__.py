@@ -1,7 +1,10 @@
-"""Contractors: forward-backward on a tape, composition, fixpoint, inflation."""
+"""Contractors: forward-backward on a tape, composition, fixpoint, inflation; the range sensor
+(first-hit distance along a ray of an obstacle map)."""
 
 from .base import Contractor, Fixpoint, FunctionContractor, Inflate, Sequence, Union, shrink_ratio
 from .fwdbwd import CtcFwdBwd
+from .obstacles import ObstacleMap
+from .raycast import CtcRayCast
 
-__all__ = ["Contractor", "CtcFwdBwd", "Fixpoint", "FunctionContractor", "Inflate", "Sequence",
-           "Union", "shrink_ratio"]
+__all__ = ["Contractor", "CtcFwdBwd", "CtcRayCast", "Fixpoint", "FunctionContractor", "Inflate",
+           "ObstacleMap", "Sequence", "Union", "shrink_ratio"]
