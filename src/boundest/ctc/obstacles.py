@@ -180,7 +180,7 @@ class ObstacleMap:
                                            for v in (x, y, beta)))
         c, s = np.cos(beta), np.sin(beta)
         best = np.full(x.shape, np.inf)
-        with np.errstate(divide="ignore", invalid="ignore"):
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             for (ax, ay), (bx, by) in self.segments:
                 ex, ey = bx - ax, by - ay
                 wx, wy = ax - x, ay - y

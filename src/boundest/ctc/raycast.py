@@ -12,14 +12,15 @@ necessary conditions of ``d = g(x, y, beta)``, written with ``u = (cos beta, sin
     ``u x v = u_x v_y - u_y v_x``, ``e = b - a`` and ``w = p - c`` evaluated on the tape):
 
     - segment ``a -> b``: ``p + d u = a + tau e``, ``tau in [0, 1]``,
-      ``d (u x e) = (a - p) x e``, ``d >= 0``;
+      ``d (u x e) = (a - p) x e``, ``d^2 = |a + tau e - p|^2``, ``d >= 0``;
     - circle ``(c, rho)``: ``|w + d u|^2 = rho^2``, ``u . (w + d u) <= 0``,
       ``d = -u . w - sqrt(rho^2 - (u x w)^2)``, ``d >= 0``.
 
     Sound: if ``O`` is the first obstacle hit, the true tuple satisfies all of ``O``'s
     constraints. For a segment the hit point is ``a + tau e`` with ``0 <= tau <= 1``, and the
     data formula ``s = ((a - p) x e) / (u x e)`` gives the third equation (which also holds,
-    as ``0 = 0``, for a ray along the segment's line). For a circle, ``|w|^2 = (u . w)^2 +
+    as ``0 = 0``, for a ray along the segment's line); the fourth is ``|d u| = d`` (it bounds
+    ``d`` without ``beta``, when ``beta`` is wide). For a circle, ``|w|^2 = (u . w)^2 +
     (u x w)^2`` turns the near root ``s = -b - sqrt(b^2 - q)`` of the data formulas
     (``b = u . w``, ``q = |w|^2 - rho^2``) into the third equation, and
     ``u . (w + s u) = b + s = -sqrt(b^2 - q) <= 0`` (the near side). So the true tuple
@@ -165,9 +166,10 @@ def _segment_constraints(a: np.ndarray, b: np.ndarray) -> list[Constraint]:
     ax, ay, bx, by = (Const(float(v)) for v in (a[0], a[1], b[0], b[1]))
     ex, ey = bx - ax, by - ay  # evaluated on the tape, outward rounded
     ux, uy = cos(beta), sin(beta)
-    return [x + d * ux == ax + tau * ex,
-            y + d * uy == ay + tau * ey,
+    hx, hy = ax + tau * ex, ay + tau * ey  # the hit point
+    return [x + d * ux == hx, y + d * uy == hy,
             d * (ux * ey - uy * ex) == (ax - x) * ey - (ay - y) * ex,
+            sqr(d) == sqr(hx - x) + sqr(hy - y),
             tau.in_((0.0, 1.0)), d >= 0]
 
 
