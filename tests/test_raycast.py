@@ -91,9 +91,15 @@ def free_points(draw):
     y = draw(st.floats(0.001, 9.999))
     for (cx, cy), r in zip(POOL.centers, POOL.radii, strict=True):
         assume(math.hypot(x - cx, y - cy) > r + 1e-3)
+    # grazing rays: aimed at a wall's end (a corner) or tangent to a pillar, up to rounding
+    grazing = [math.atan2(ay - y, ax - x) for ax, ay in POOL.segments[:, 0]]
+    for (cx, cy), r in zip(POOL.centers, POOL.radii, strict=True):
+        side = math.asin(r / math.hypot(cx - x, cy - y))
+        grazing += [math.atan2(cy - y, cx - x) + side, math.atan2(cy - y, cx - x) - side]
     beta = draw(st.one_of(st.floats(-math.pi, math.pi), st.floats(-20.0, 20.0),
                           st.sampled_from([0.0, math.pi / 2, math.pi, -math.pi / 2,
-                                           math.pi / 4])))
+                                           math.pi / 4]),
+                          st.sampled_from(grazing)))
     return x, y, beta
 
 
