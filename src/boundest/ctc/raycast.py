@@ -87,8 +87,8 @@ class CtcRayCast(Contractor):
     1.4 m, so a reading of 15 m (the far wall) is impossible, and one of about 1.4 m pins x.
 
     >>> ctc = CtcRayCast(ObstacleMap.pool())
-    >>> ctc(Interval([4.9, 6.5, 0.0, 14.0], [5.1, 6.5, 0.0, 16.0])).is_empty().all()
-    np.True_
+    >>> bool(ctc(Interval([4.9, 6.5, 0.0, 14.0], [5.1, 6.5, 0.0, 16.0])).is_empty().all())
+    True
     >>> box = ctc(Interval([4.0, 6.5, 0.0, 1.39], [6.0, 6.5, 0.0, 1.41]))
     >>> bool(4.98 < box.lo[0] < box.hi[0] < 5.02)
     True
