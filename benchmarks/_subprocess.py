@@ -16,6 +16,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import Any
 
 
 def run_json_script(python: Path, script: Path, spec: dict, timeout: float | None = None
@@ -51,3 +52,15 @@ def fegetround() -> int | None:
         return int(libm.fegetround())
     except (OSError, AttributeError, TypeError):
         return None
+
+
+def decode_hex(obj: Any) -> Any:
+    """Every string holding a ``float.hex`` becomes a float (lists and dicts recursively): how
+    the Codac scripts read their spec, under round-to-nearest, before importing codac."""
+    if isinstance(obj, dict):
+        return {k: decode_hex(v) for k, v in obj.items()}
+    if isinstance(obj, list):
+        return [decode_hex(v) for v in obj]
+    if isinstance(obj, str) and obj.startswith(("0x", "-0x", "inf", "-inf")):
+        return float.fromhex(obj)
+    return obj

@@ -78,22 +78,13 @@ import tempfile
 import time
 from typing import Any
 
-from _subprocess import fegetround
+from _subprocess import decode_hex, fegetround
 
 
 def _h(v: float) -> str:
     return float(v).hex()
 
 
-def _decode(obj: Any) -> Any:
-    """Every string holding a ``float.hex`` becomes a float (lists and dicts recursively)."""
-    if isinstance(obj, dict):
-        return {k: _decode(v) for k, v in obj.items()}
-    if isinstance(obj, list):
-        return [_decode(v) for v in obj]
-    if isinstance(obj, str) and obj.startswith(("0x", "-0x", "inf", "-inf")):
-        return float.fromhex(obj)
-    return obj
 
 
 def _log(msg: str) -> None:
@@ -145,7 +136,7 @@ class _CaptureStdout:
 
 def main() -> None:
     with open(sys.argv[1]) as fh:
-        spec = _decode(json.load(fh))      # decoded under round-to-nearest, before codac
+        spec = decode_hex(json.load(fh))      # decoded under round-to-nearest, before codac
     mode_before = fegetround()
     t0 = time.perf_counter()
     from codac import (

@@ -61,7 +61,7 @@ import statistics
 import sys
 import time
 
-from _subprocess import fegetround
+from _subprocess import decode_hex, fegetround
 
 MODES = ("centered", "natural", "default")
 
@@ -70,15 +70,6 @@ def _h(v: float) -> str:
     return float(v).hex()
 
 
-def _decode(obj):
-    """Every string holding a ``float.hex`` becomes a float (lists and dicts recursively)."""
-    if isinstance(obj, dict):
-        return {k: _decode(v) for k, v in obj.items()}
-    if isinstance(obj, list):
-        return [_decode(v) for v in obj]
-    if isinstance(obj, str) and obj.startswith(("0x", "-0x", "inf", "-inf")):
-        return float.fromhex(obj)
-    return obj
 
 
 def _rows(flat: list, width: int) -> list:
@@ -91,7 +82,7 @@ def _log(msg: str) -> None:
 
 def main() -> None:
     with open(sys.argv[1]) as fh:
-        spec = _decode(json.load(fh))      # decoded under round-to-nearest, before codac
+        spec = decode_hex(json.load(fh))      # decoded under round-to-nearest, before codac
     mode_before = fegetround()
     t0 = time.perf_counter()
     from codac import (
