@@ -305,3 +305,14 @@ def test_network_report_and_errors():
         cn.contract(rel_eps=2)
     with pytest.raises(ValueError, match="domains"):
         cn.add(CtcDeriv(), [x, 3.0])
+
+
+def test_network_progress_has_no_false_total(capsys):
+    # the iteration cap is not a forecast: the bar counts iterations and shows the contraction
+    x = Tube.constant(0, 1, 10, Interval.entire())
+    x.gates[0] = Interval(0, 0)
+    cn = ContractorNetwork()
+    cn.add(CtcDeriv(), [x, Tube.constant(0, 1, 10, Interval(-1, 1))])
+    report = cn.contract(max_iter=100, progress=True)
+    err = capsys.readouterr().err
+    assert f"{report.iterations}it" in err and "/100" not in err and "contraction=" in err

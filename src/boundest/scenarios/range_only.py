@@ -430,7 +430,8 @@ def solve(meas: Measurements | None = None, dt: float = 0.01, rel_eps: float = 1
     start = time.perf_counter()
     rep = net.dead_reckoning.contract(rel_eps=rel_eps, max_iter=max_iter, progress=False)
     empty = rep.empty
-    with tqdm(total=max_iter, desc="range-only", delay=2.0 if progress is None else 0.0,
+    # a counter, not a total: the fixed point comes long before the cap (max_iter)
+    with tqdm(desc="range-only", unit="it", delay=2.0 if progress is None else 0.0,
               disable=progress is False or empty) as bar:
         while iterations < max_iter and not empty:
             rep = net.position.contract(rel_eps=rel_eps, max_iter=1, progress=False)
@@ -442,6 +443,7 @@ def solve(meas: Measurements | None = None, dt: float = 0.01, rel_eps: float = 1
                 break
             g = net.x.gates.width()[::step]
             diag.append(np.hypot(g[:, 0], g[:, 1]))
+            bar.set_postfix(contraction=f"{contraction[-1]:.2e}", stop_below=f"{rel_eps:.0e}")
             if rep.converged:
                 converged = True
                 break

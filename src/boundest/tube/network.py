@@ -145,8 +145,10 @@ class ContractorNetwork:
         report = NetworkReport()
         start = time.perf_counter()
         before = self._widths()
-        bar = tqdm(total=max_iter, desc="contractor network",
-                   delay=2.0 if progress is None else 0.0, disable=progress is False)
+        # no total: the number of iterations to the fixed point is not known in advance (the
+        # cap is not a forecast); the bar counts iterations and shows the last contraction
+        bar = tqdm(desc="contractor network", unit="it", delay=2.0 if progress is None else 0.0,
+                   disable=progress is False)
         try:
             while report.iterations < max_iter:
                 ok = self.contract_once()
@@ -169,7 +171,7 @@ class ContractorNetwork:
                     bounded += int(np.count_nonzero(np.isfinite(wa))) - int(np.count_nonzero(fin_b))
                 report.contraction.append(ratio)
                 report.newly_bounded.append(bounded)
-                bar.set_postfix(contraction=f"{ratio:.2e}")
+                bar.set_postfix(contraction=f"{ratio:.2e}", stop_below=f"{rel_eps:.0e}")
                 before = after
                 if ratio < rel_eps and bounded == 0:
                     report.converged = True
