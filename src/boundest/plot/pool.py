@@ -138,9 +138,11 @@ def plot_pool_emission(data: PoolData, consistent: NDArray[np.bool_], k: int | N
     ax.plot([], [], color="0.3", lw=2.5, label="range box [d_lo, d_hi] (thick)")
     ax.plot([0], [0], "^", color=PATH, ms=9, label="robot (heading +x)")
     ax.set_aspect("equal")
-    r = float(np.nanmax(mid[np.isfinite(mid)])) if np.isfinite(mid).any() else 1.0
-    ax.set_xlim(-1.05 * r, 1.05 * r)
-    ax.set_ylim(-1.05 * r, 1.05 * r)
+    end = np.stack([mid * np.cos(a), mid * np.sin(a)], -1)
+    end = np.concatenate([end[np.isfinite(end).all(-1)], np.zeros((1, 2))])
+    pad = 0.05 * float(np.ptp(end, axis=0).max()) + 0.5
+    ax.set_xlim(end[:, 0].min() - pad, end[:, 0].max() + pad)
+    ax.set_ylim(end[:, 1].min() - pad, end[:, 1].max() + pad)
     ax.set_xlabel("forward, robot frame (m)")
     ax.set_ylabel("left, robot frame (m)")
     ax.legend(loc="upper left", fontsize=7)
