@@ -94,14 +94,17 @@ def plot_pool_snapshot(data: PoolData, res: PoolResult, k: int,
     """The pool, the centre path up to step ``k``, the ``(x, y)`` box at ``k`` and (``pings``)
     the window's pings: ping ``j`` drawn from the centre of ``X_j`` along
     ``theta_centre_j + alpha_j`` with the length ``d_mid`` of its range box, kept pings in one
-    colour and those :func:`ping_consistency` rejects in grey."""
+    colour and those :func:`ping_consistency` rejects in grey (none where ``theta_j`` is
+    unbounded, after a restart)."""
     ax = plot_pool_map(data, ax)
     c = res.centre()
     ax.plot(c[: k + 1, 0], c[: k + 1, 1], color=PATH, lw=0.8, label="box centre path")
     if pings:
         j = window_of(res, k)
         d = data.ranges[j].mid()
-        beta = c[j, 2] + data.alpha[j]
+        th = res.boxes[j, 2]
+        bounded = np.isfinite(th.lo) & np.isfinite(th.hi)  # no heading after a restart
+        beta = np.where(bounded, c[j, 2] + data.alpha[j], np.nan)
         ok = consistent[j]
         _rays(ax, c[j, 0][ok], c[j, 1][ok], beta[ok], d[ok], colors=KEPT, lw=0.6, alpha=0.8)
         _rays(ax, c[j, 0][~ok], c[j, 1][~ok], beta[~ok], d[~ok], colors=REJECTED, lw=1.6,
