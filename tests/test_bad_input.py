@@ -299,6 +299,7 @@ def test_the_json_convention():
     ["run", "range-only", "--dt", "0.5", "--max-iter", "3"],
     ["run", "drifting-clock", "--dt", "0.1"],
     ["run", "auv", "--mode", "localization"],
+    ["run", "pool", "--m", "40"],
 ], ids=lambda a: " ".join(a[:3]))
 def test_every_command_writes_strict_json(tmp_path, capsys, argv):
     js = tmp_path / "out.json"

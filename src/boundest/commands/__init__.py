@@ -94,7 +94,7 @@ def write_json(data: dict, path: str | None) -> None:
         print(f"wrote {path}")
 
 
-from . import auv, drifting_clock, jaulin2001, range_only, satellite  # noqa: E402
+from . import auv, drifting_clock, jaulin2001, pool, range_only, satellite  # noqa: E402
 
 # add a scenario by importing its module above and listing it here
-RUNS = [satellite, jaulin2001, range_only, drifting_clock, auv]
+RUNS = [satellite, jaulin2001, range_only, drifting_clock, auv, pool]

@@ -1,0 +1,173 @@
+"""``boundest run pool``: the pool robot of Jaulin's robust set-membership observer (a recursive
+q-relaxed box observer over sonar pings with outliers) on the embedded mission.
+
+What the sets guarantee (:mod:`boundest.estimation.robust`): ``x_k`` is in ``X_k`` whenever every
+window of ``m`` pings since the start or the last restart held at most ``q`` outliers. The
+printed ``P(at most q outliers in m pings)`` is the binomial probability of that event for ONE
+window; the event the recursive set needs (every window since the last restart) has a
+probability at most that.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+import numpy as np
+
+from . import pyplot, save_figure, write_json
+
+GUARANTEE = ("the probability that one window of {m} pings holds at most {q} outliers; the "
+             "recursive set X_k holds the true state whenever every window since the last "
+             "restart held at most {q} outliers, an event whose probability is at most this "
+             "(it is not a lower bound on P(x_k in X_k))")
+
+
+def table_rows(data, res, rows: int = 10) -> list[dict]:
+    """The paper's table: ``rows`` steps at regular times, with the window probability and the
+    pings rejected in the window."""
+    from ..plot.pool import window_of
+
+    ks = np.unique(np.rint(np.linspace(0, data.n - 1, rows)).astype(int))
+    return [{"k": int(k), "t": float(data.t[k]), "window": int(window_of(res, int(k)).size),
+             "window_probability": float(res.window_probability[k]),
+             "rejected": int(res.rejected[k]), "empty": bool(res.empty[k])} for k in ks]
+
+
+def format_table(rows: list[dict], q: int) -> str:
+    head = (f"{'k':>4} {'t (s)':>7} {'window':>6} {f'P(<= {q} outliers)':>18} "
+            f"{'rejected':>8} {'empty':>5}")
+    lines = [head] + [f"{r['k']:>4} {r['t']:>7.2f} {r['window']:>6} "
+                      f"{r['window_probability']:>18.6f} {r['rejected']:>8} "
+                      f"{'yes' if r['empty'] else 'no':>5}" for r in rows]
+    return "\n".join(lines)
+
+
+def _mean_widths(res) -> tuple[np.ndarray, int]:
+    """Mean widths over the steps whose box is bounded (a restart box has an unbounded theta)."""
+    w = res.widths()
+    ok = np.isfinite(w).all(axis=1)
+    return (w[ok].mean(axis=0) if ok.any() else np.full(4, np.nan)), int(ok.sum())
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..scenarios.pool import solve_pool
+    from ..scenarios.pool_data import binomial_bound, load_pool
+
+    if args.q < 0 or args.m < 1:
+        raise ValueError(f"need --q >= 0 and --m >= 1, got --q {args.q} --m {args.m}")
+    start = time.perf_counter()
+    data = load_pool(args.data)
+    read_s = time.perf_counter() - start
+    print(f"pool robot: {data.n} pings over {data.n * data.dt:.1f} s (dt = {data.dt:g} s), "
+          f"outlier probability {data.p_outlier:g} per ping (data: {data.source}; read in "
+          f"{read_s:.2f} s)")
+    res = solve_pool(data, q=args.q, m=args.m)
+    p_full = binomial_bound(args.m, args.q, data.p_outlier)
+    print(f"q = {args.q} outliers allowed in a window of m = {args.m} pings: "
+          f"P(at most {args.q} outliers in {args.m} pings) = {p_full:.6f},")
+    print("  " + GUARANTEE.format(m=args.m, q=args.q))
+    w, nw = _mean_widths(res)
+    note = "" if nw == data.n else f" (over the {nw} steps with a bounded box)"
+    print(f"mean widths{note}: x {w[0]:.3f} m, y {w[1]:.3f} m, theta {w[2]:.3f} rad, "
+          f"v {w[3]:.3f} m/s")
+    empty = np.flatnonzero(res.empty)
+    where = "" if not empty.size else ": at " + ", ".join(
+        f"k = {k} (t = {data.t[k]:.2f} s)" for k in empty[:10]) + (
+        f" and {empty.size - 10} more" if empty.size > 10 else "")
+    print(f"empty steps (restarts): {empty.size}{where}")
+    kmax = int(np.argmax(res.rejected))
+    print(f"most pings rejected in a window: {int(res.rejected[kmax])} (first at k = {kmax}, "
+          f"t = {data.t[kmax]:.2f} s)")
+    print(f"time: {res.time_s:.2f} s for the observer")
+    rows = table_rows(data, res)
+    table = format_table(rows, args.q)
+    print("table (P: one window, see above):")
+    print(table)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "pool_table.txt").write_text(
+        f"# boundest run pool, q = {args.q}, m = {args.m}, data: {data.source}\n"
+        f"# P: {GUARANTEE.format(m=args.m, q=args.q)}\n"
+        f"# rejected: pings of the window inconsistent with X_k\n{table}\n")
+    print(f"wrote {out / 'pool_table.txt'}")
+
+    plt = pyplot()
+    from ..plot.pool import (
+        ping_consistency,
+        plot_pool_emission,
+        plot_pool_snapshot,
+        plot_pool_trajectory,
+        plot_pool_widths,
+        window_of,
+    )
+
+    consistent = ping_consistency(data, res)
+    snaps = np.unique(np.rint(np.linspace(0, data.n - 1, 6)).astype(int))
+    fig, axes = plt.subplots(2, 3, figsize=(15, 6.4))
+    for i, (ax, k) in enumerate(zip(axes.flat, snaps, strict=False)):
+        last = i == len(snaps) - 1
+        plot_pool_snapshot(data, res, int(k), consistent, ax=ax, pings=last)
+        ax.set_title(f"t = {data.t[k]:.2f} s (k = {k}): (x, y) box"
+                     + (f", the window's {window_of(res, int(k)).size} pings" if last else ""),
+                     fontsize=9)
+        if last:
+            ax.legend(loc="lower left", fontsize=6)
+    for ax in list(axes.flat)[len(snaps):]:
+        ax.set_visible(False)
+    fig.suptitle(f"pool robot, q = {args.q}, m = {args.m}. Last panel: each ping of the window "
+                 "drawn from the box centre at its time along theta_centre + alpha, length "
+                 "d_mid; grey: the ray-cast contractor empties (X_j, ping j)", fontsize=10)
+    save_figure(fig, args.out, "pool_snapshots")
+
+    fig, ax = plt.subplots(figsize=(7, 7))
+    plot_pool_emission(data, consistent, ax=ax)
+    ax.set_title(f"emission diagram: the last {min(80, data.n)} pings (one revolution) "
+                 f"up to t = {data.t[-1]:.2f} s, robot frame", fontsize=10)
+    save_figure(fig, args.out, "pool_emission")
+
+    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(10, 8.5),
+                                   gridspec_kw={"height_ratios": [1.6, 1]})
+    plot_pool_trajectory(data, res, ax=ax1)
+    ax1.set_title(f"trajectory envelope (q = {args.q}, m = {args.m})")
+    plot_pool_widths(data, res, ax=ax2)
+    ax2.set_title("widths of the state box against time")
+    save_figure(fig, args.out, "pool_trajectory")
+
+    if args.json:
+        write_json(to_json(data, res, args, p_full, rows), args.json)
+    return 1 if res.empty.all() else 0
+
+
+def to_json(data, res, args, p_full: float, rows: list[dict]) -> dict:
+    w, nw = _mean_widths(res)
+    c = res.centre()
+    steps = [{"k": k, "t": float(data.t[k]), "box": res.boxes[k], "centre": c[k],
+              "window_probability": float(res.window_probability[k]),
+              "rejected": int(res.rejected[k]), "empty": bool(res.empty[k])}
+             for k in range(data.n)]
+    return {"scenario": "pool", "data": data.source, "samples": data.n, "t0": data.t0,
+            "dt": data.dt, "p_outlier": data.p_outlier, "q": args.q, "m": args.m,
+            "window_probability": p_full,
+            "guarantee": GUARANTEE.format(m=args.m, q=args.q),
+            "width_mean": w, "width_mean_steps": nw,
+            "empty_steps": np.flatnonzero(res.empty), "max_rejected": int(res.rejected.max()),
+            "time_s": res.time_s, "table": rows, "steps": steps}
+
+
+def register(runs: argparse._SubParsersAction) -> None:
+    """Add ``boundest run pool`` and its options."""
+    p = runs.add_parser("pool", help="pool robot (Jaulin's robust set-membership observer): "
+                                     "a recursive q-relaxed observer over sonar pings")
+    p.add_argument("--q", type=int, default=8,
+                   help="outliers allowed in a window (default 8)")
+    p.add_argument("--m", type=int, default=80,
+                   help="window length in pings (default 80: one sonar revolution)")
+    p.add_argument("--data", help="folder holding pool_setup.json, pool_map.json and the files "
+                   "the setup names (default: the embedded mission; docs/data-format.md)")
+    p.add_argument("--out", default="out", help="folder for figures and pool_table.txt "
+                   "(default: out)")
+    p.add_argument("--json", help="write the summary and every step's box as JSON to this file "
+                   "(strict JSON: docs/json.md)")
+    p.set_defaults(func=run)
