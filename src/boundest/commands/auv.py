@@ -60,10 +60,13 @@ def run(args: argparse.Namespace) -> int:
     print(f"AUV survey: {data.n} samples over {data.n * data.dt:.0f} s, {data.fix_k.size} GPS "
           f"fixes, {data.det_k.size} detections of {data.n_mines} mines (data: {data.source}; "
           f"read in {time.perf_counter() - start:.2f} s)")
+    print("localization ... (the first run compiles the kernels it uses, about 40 s on 2 cores; "
+          "cached afterwards)", flush=True)
     loc = auv.localize(data)
     _summary(loc, data)
     results = [loc]
     if args.mode == "slam":
+        print("SLAM: detections and dead reckoning in one contractor network ...", flush=True)
         res = auv.slam(data, rel_eps=args.rel_eps, max_iter=args.max_iter)
         _summary(res, data)
         results.append(res)
