@@ -21,7 +21,7 @@ from . import pyplot, save_figure, write_json
 GUARANTEE = ("the probability that one window of {m} pings holds at most {q} outliers; the "
              "recursive set X_k holds the true state whenever every window since the last "
              "restart held at most {q} outliers, an event whose probability is at most this "
-             "(it is not a lower bound on P(x_k in X_k))")
+             "(so it is not a proven lower bound on P(x_k in X_k))")
 
 
 def table_rows(data, res, rows: int = 10) -> list[dict]:
