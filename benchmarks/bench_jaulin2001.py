@@ -1,4 +1,5 @@
-"""Seed 002 test case (equation 21) with subpavings: boundest's RCSE and NCSE against Codac 1.5.7.
+"""Jaulin et al. 2001 test case (equation 21) with subpavings: boundest's RCSE and NCSE against
+Codac 1.5.7.
 
 boundest: ``boundest.scenarios.jaulin2001.solve`` (subpavings, x(0) paved in [-4, 4]^2) at each
 ``--eps``; time of RCSE and NCSE (median of ``--repeat`` runs after a warm-up run), hull widths
@@ -88,7 +89,7 @@ def main() -> None:
         print(f"boundest eps={e} ...", file=sys.stderr)
         rows.append(bench_boundest(e, args.repeat))
     codac1 = None if args.no_codac else bench_codac1(args.codac_eps, args.repeat)
-    doc = {"benchmark": "jaulin2001 (seed 002 eq. 21), subpavings",
+    doc = {"benchmark": "jaulin2001 (Jaulin et al. 2001 eq. 21), subpavings",
            "machine": {"cpu": cpu_model(), "cpus": os.cpu_count(),
                        "python": platform.python_version(), "numpy": np.__version__,
                        "loadavg": os.getloadavg()},

@@ -1,4 +1,4 @@
-"""Satellite benchmark (seed 000): boundest's propagation against Codac 1.5.7, k_max = 100..1600.
+"""Satellite benchmark (Jaulin 2002): boundest's propagation against Codac 1.5.7, k_max = 100..1600.
 
 For each data set it reports boundest's time to the fixed point of the satellite CSP
 (``boundest.scenarios.satellite.solve``, ``time_s``: propagation only, the model's compilation
@@ -444,7 +444,7 @@ def main() -> None:
 
     summary = _summary(rows, args.codac_variants if "formulation" in codac_info else [])
     doc = {
-        "benchmark": "satellite (seed 000, equation 14)",
+        "benchmark": "satellite (Jaulin 2002, equation 14)",
         "what": {
             "time_s": "median over the repeats of the propagation time (wall clock); boundest: "
                       "SatelliteResult.time_s (model compilation excluded, reported as "

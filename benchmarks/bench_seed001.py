@@ -1,4 +1,4 @@
-"""Seed 001 benchmark: the range-only robot and the drifting clock against Codac 1.5.7.
+"""Rohou et al. 2018 benchmark: the range-only robot and the drifting clock against Codac 1.5.7.
 
 For each case it reports boundest's time to the fixed point (``solve(...).time_s``: the
 contraction only, building the tubes excluded and reported as ``build_s``), the median of

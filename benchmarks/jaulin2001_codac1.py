@@ -1,4 +1,5 @@
-"""Codac 1.5.7 side of the jaulin2001 benchmark (seed 002 eq. 21); run by bench_jaulin2001.py.
+"""Codac 1.5.7 side of the jaulin2001 benchmark (Jaulin et al. 2001 eq. 21); run by
+bench_jaulin2001.py.
 
 Run with ``.bench-venv-codac1/bin/python`` in its own process (importing codac switches the FPU
 to rounding upward). Input: a JSON file with the measurement bounds as ``float.hex`` strings,

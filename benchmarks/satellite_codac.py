@@ -1,4 +1,5 @@
-"""Codac 1.5.7 side of the satellite benchmark (seed 000, equation 14); run by bench_satellite.py.
+"""Codac 1.5.7 side of the satellite benchmark (Jaulin 2002, equation 14); run by
+bench_satellite.py.
 
 Run it with the interpreter of ``.bench-venv-codac1/`` (``codac==1.5.7``), never in the process
 that runs boundest: importing codac switches the FPU to rounding upward (Gaol), and boundest

@@ -1,4 +1,4 @@
-"""Codac 1.5.7 side of the seed 001 benchmark (range-only robot, drifting clock); run by
+"""Codac 1.5.7 side of the Rohou et al. 2018 benchmark (range-only robot, drifting clock); run by
 ``bench_seed001.py``.
 
 Run it with the interpreter of ``.bench-venv-codac1/`` (``codac==1.5.7``), never in the process
@@ -6,7 +6,7 @@ that runs boundest: importing codac switches the FPU to rounding upward. Input: 
 written by ``bench_seed001.py`` in which every float is a ``float.hex`` string, decoded *before*
 codac is imported. Output: one JSON document on stdout, enclosures as ``float.hex`` strings.
 
-Models (seed 001, CN (15) and CN (20), as ``boundest.scenarios.range_only`` and
+Models (Rohou et al. 2018, CN (15) and CN (20), as ``boundest.scenarios.range_only`` and
 ``drifting_clock`` build them), Codac's own contractors over tubes sliced every ``dt``:
 
 range-only robot::

@@ -96,7 +96,7 @@ def test_division_by_intervals_containing_zero():
 
 
 def test_seed_004_examples():
-    # seed 004 section 6.1
+    # Jaulin, Bertholom, Dabe 2007 section 6.1
     assert bd.add(Interval(-1, 3), Interval(2, 5)) == Interval(1, 8)
     assert bd.mul(Interval(-1, 3), Interval(2, 5)) == Interval(-5, 15)
     assert bd.div(Interval(-1, 3), Interval(2, 5)) == Interval(-0.5, 1.5)

@@ -1,4 +1,5 @@
-"""The drifting clock of seed 001 (section 5): data, truth, soundness and the seed's results."""
+"""The drifting clock of Rohou et al. 2018 (section 5): data, truth, soundness and the seed's
+results."""
 
 from __future__ import annotations
 
@@ -77,7 +78,7 @@ def test_seed_truth_fits_table_2_and_the_model():
 
 
 def test_seed_truth_inside_every_domain():
-    """Seed 001 section 5: the real drift (eq. 16) stays in [h]; every exact reference time
+    """Rohou et al. 2018 section 5: the real drift (eq. 16) stays in [h]; every exact reference time
     h^{-1}(tau_i) stays in its contracted [t_i]."""
     res = dc.solve()
     assert res.consistent and res.converged
@@ -114,7 +115,8 @@ def test_inconsistent_distance_is_proven_empty():
 
 # -- the seed's results ---------------------------------------------------------------------
 def test_seed_results():
-    """Seed 001 section 5: the fixed point within a few iterations (5 in the paper), every [t_i]
+    """Rohou et al. 2018 section 5: the fixed point within a few iterations (5 in the paper),
+    every [t_i]
     after the first contracted by the ephemeris (Fig. 12), [h] thin (Fig. 12: about 1 s)."""
     res = dc.solve()
     assert res.converged and res.iterations <= 10

@@ -1,6 +1,7 @@
-"""Set state estimators of seed 002 (RCSE, NCSE, CSE) on equation 21: the exact truth (mpmath)
+"""Set state estimators of Jaulin et al. 2001 (RCSE, NCSE, CSE) on equation 21: the exact truth
+(mpmath)
 stays inside every set over many simulated runs, and the last causal and non-causal sets
-coincide (seed 002 section 5)."""
+coincide (Jaulin et al. 2001 section 5)."""
 
 from __future__ import annotations
 
@@ -65,7 +66,7 @@ def test_subpaving_estimators_keep_the_truth(seed):
                 assert exact_inside(run.x[0], d)
                 continue
             assert exact_inside(run.x[k], d), (est, k)
-    # seed 002 section 5: both estimators end with the same information
+    # Jaulin et al. 2001 section 5: both estimators end with the same information
     a, b = res.rcse.x[-1], res.ncse.x[-1]
     assert np.array_equal(a.hull().lo, b.hull().lo) and np.array_equal(a.hull().hi,
                                                                          b.hull().hi)
@@ -77,7 +78,7 @@ def test_subpaving_estimators_keep_the_truth(seed):
 
 def test_the_seed_data_set_is_consistent_and_contains_the_seed_truth():
     y = jw.load()
-    truth = jw.simulate((0.0, 0.0), seed=0).x  # x*(0) = (0, 0) as in seed 002
+    truth = jw.simulate((0.0, 0.0), seed=0).x  # x*(0) = (0, 0) as in Jaulin et al. 2001
     res = jw.solve(y, eps=0.02)
     for est in (res.rcse, res.ncse):
         for k in range(1, 11):

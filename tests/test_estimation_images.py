@@ -98,7 +98,7 @@ def test_the_cell_grid_never_loosens_the_image(seed, eps, as_box):
 
 
 def test_the_grid_drops_most_boxes_of_the_seed_case():
-    """Seed 002's first step: the image of the frame [-4, 4]^2 within the hull of x(1)'s
+    """Jaulin et al. 2001's first step: the image of the frame [-4, 4]^2 within the hull of x(1)'s
     reciprocal image. With the grid, the boxes whose cells are all known stop early."""
     v_in = Subpaving(Interval([[-4.0, -4.0]], [[4.0, 4.0]]), np.zeros(1, dtype=bool))
     v_out = Subpaving(Interval([[-0.25, -3.0]], [[-0.08, 3.0]]), np.zeros(1, dtype=bool))

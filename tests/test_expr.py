@@ -250,7 +250,7 @@ def test_model_declare_add_and_names():
 # 2. the model text format
 # -------------------------------------------------------------------------------------------
 
-SATELLITE = """// RealPaver model of the satellite, first step (seed 000, section 4)
+SATELLITE = """// RealPaver model of the satellite, first step (Jaulin 2002, section 4)
 Bisection none;
 x1_0 in [0,+oo[,
 x2_0 in [0,+oo[,   # a comment after a declaration

@@ -1,4 +1,5 @@
-"""The range-only robot of seed 001 (section 4): data, truth, soundness and the seed's results."""
+"""The range-only robot of Rohou et al. 2018 (section 4): data, truth, soundness and the seed's
+results."""
 
 from __future__ import annotations
 
@@ -173,7 +174,7 @@ def test_inconsistent_range_is_proven_empty():
 
 # -- the seed's results ---------------------------------------------------------------------
 def test_seed_results_at_dt_001():
-    """Seed 001 Fig. 8: fixed point reached (52 iterations in the paper), the position-box
+    """Rohou et al. 2018 Fig. 8: fixed point reached (52 iterations in the paper), the position-box
     diagonal of the order of 10 m (5-30 m over the mission in Fig. 8), the truth inside."""
     res = ro.solve(dt=0.01, progress=False)
     assert res.consistent and res.converged and res.iterations < 52

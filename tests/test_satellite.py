@@ -1,4 +1,4 @@
-"""The satellite scenario (seed 000): soundness on simulated truths, data checks, beta-tuning,
+"""The satellite scenario (Jaulin 2002): soundness on simulated truths, data checks, beta-tuning,
 the model text format and the command line."""
 
 from __future__ import annotations
@@ -45,7 +45,7 @@ def test_published_data_enclosures_are_comparable_to_the_seed():
     res = sat.solve(sat.load())
     assert res.consistent
     width = res.x_hi - res.x_lo
-    # seed 000 section 4 (RealPaver, its own data): x1(0) width 0.13, x2(0) 0.54, x3(0) 0.26,
+    # Jaulin 2002 section 4 (RealPaver, its own data): x1(0) width 0.13, x2(0) 0.54, x3(0) 0.26,
     # x4(0) 0.73; x(200) widths 0.50, 0.23, 0.69, 0.33. Same order of magnitude here:
     assert np.all(width[0] < 0.9) and np.all(width[200] < 0.9)
     assert np.mean(width[:, 0]) < 0.77  # Codac 1.5.7 on this data: mean width of x1 0.77

@@ -1,4 +1,5 @@
-"""FALL/CLIMB on tree SCSPs (seed 002, section 3.2): optimality against brute force and against
+"""FALL/CLIMB on tree SCSPs (Jaulin et al. 2001, section 3.2): optimality against brute force and
+against
 every other order of local contractions (Waltz), on finite-set and interval domains."""
 
 from __future__ import annotations
@@ -109,7 +110,8 @@ def test_graphs_that_are_not_trees_are_refused():
 
 
 def test_waltz_deadlocks_on_the_cycle_of_seed_example_2():
-    """Seed 002 Example 2: v2 = -v1, v3 = -v2, v1 = -v3 on [-1, 1]^3; only 0 is a solution but
+    """Jaulin et al. 2001 Example 2: v2 = -v1, v3 = -v2, v1 = -v3 on [-1, 1]^3; only 0 is a
+    solution but
     local contractions remove nothing. (FALL/CLIMB needs a tree, which is why it is refused.)"""
     neg = Arc("p", "q", lambda vp, vq: vp & -vq, lambda vq, vp: vq & -vp)
     doms = Interval(-1.0, 1.0)

@@ -1,4 +1,4 @@
-"""``boundest run drifting-clock``: seed 001 section 5 end to end, with Figs. 11 and 12."""
+"""``boundest run drifting-clock``: Rohou et al. 2018 section 5 end to end, with Figs. 11 and 12."""
 
 from __future__ import annotations
 
@@ -16,7 +16,7 @@ def run(args: argparse.Namespace) -> int:
     from ..scenarios import drifting_clock as dc
 
     meas = dc.load(args.data)
-    print(f"drifting clock (seed 001): {len(meas)} measurements, data {meas.source}")
+    print(f"drifting clock (Rohou et al. 2018): {len(meas)} measurements, data {meas.source}")
     res = dc.solve(meas, dt=args.dt, rel_eps=args.rel_eps)
     if res.empty:
         print(f"proven INCONSISTENT after {res.iterations} iterations: no drift and boat path "
@@ -46,7 +46,7 @@ def run(args: argparse.Namespace) -> int:
 
 def register(runs: argparse._SubParsersAction) -> None:
     """Add ``boundest run drifting-clock`` and its options."""
-    p = runs.add_parser("drifting-clock", help="seed 001: correcting a drifting clock")
+    p = runs.add_parser("drifting-clock", help="Rohou et al. 2018: correcting a drifting clock")
     p.add_argument("--dt", type=float, default=0.01, help="slice duration (default 0.01)")
     p.add_argument("--data", help="measurement CSV, columns i,tau,z_lo,z_hi (default: the "
                    "embedded Table 2; docs/data-format.md)")

@@ -1,4 +1,5 @@
-"""``boundest run jaulin2001``: seed 002 section 5 (equation 21), with the Fig. 7 picture."""
+"""``boundest run jaulin2001``: Jaulin et al. 2001 section 5 (equation 21), with the Fig. 7
+picture."""
 
 from __future__ import annotations
 
@@ -15,7 +16,7 @@ def run(args: argparse.Namespace) -> int:
     y = jw.load(args.data)
     K = y.shape[0]
     domains = "boxes" if args.boxes else "subpavings"
-    print(f"jaulin2001 (seed 002, eq. 21): K = {K}, domains {domains}"
+    print(f"jaulin2001 (Jaulin et al. 2001, eq. 21): K = {K}, domains {domains}"
           + (f", eps = {args.eps:g}, x(0) paved in [-4, 4]^2" if not args.boxes else ""))
     res = jw.solve(y, domains=domains, eps=args.eps, progress=True)
     data = jw.to_json(res)
@@ -32,7 +33,8 @@ def run(args: argparse.Namespace) -> int:
     pyplot()  # the file-only backend, before plot_set_sequence makes its figure
     fig = plot_set_sequence([res.rcse.x, res.ncse.x], ["causal (RCSE)", "non-causal (NCSE)"],
                             jw.FRAME)
-    fig.suptitle("x(k), k = 0..10: causal and non-causal sets (seed 002, Fig. 7)", fontsize=10)
+    fig.suptitle("x(k), k = 0..10: causal and non-causal sets (Jaulin et al. 2001, Fig. 7)",
+                 fontsize=10)
     save_figure(fig, args.out, f"jaulin2001_{domains}", dpi=130)
     write_json(data, args.json)
     return 1 if empty else 0
@@ -44,7 +46,8 @@ def _f(v: float) -> str:
 
 def register(runs: argparse._SubParsersAction) -> None:
     """Add ``boundest run jaulin2001`` and its options."""
-    p = runs.add_parser("jaulin2001", help="seed 002: causal and non-causal set estimation")
+    p = runs.add_parser("jaulin2001",
+                        help="Jaulin et al. 2001: causal and non-causal set estimation")
     p.add_argument("--data", help="measurement CSV, columns k,y_lo,y_hi (default: the embedded "
                    "one; docs/data-format.md)")
     p.add_argument("--eps", type=float, default=0.01,

@@ -1,4 +1,4 @@
-"""``boundest run range-only``: seed 001 section 4 end to end, with Figs. 8 and 9."""
+"""``boundest run range-only``: Rohou et al. 2018 section 4 end to end, with Figs. 8 and 9."""
 
 from __future__ import annotations
 
@@ -17,8 +17,8 @@ def run(args: argparse.Namespace) -> int:
 
     meas = ro.load(args.data, args.beacons)
     n = int(np.ceil((ro.TF - ro.T0) / args.dt))
-    print(f"range-only robot (seed 001): {len(meas)} measurements, {meas.beacons.shape[0]} "
-          f"beacons, data {meas.source}")
+    print(f"range-only robot (Rohou et al. 2018): {len(meas)} measurements, "
+          f"{meas.beacons.shape[0]} beacons, data {meas.source}")
     print(f"tubes over [{ro.T0:g}, {ro.TF:g}] with dt = {args.dt:g} ({n} slices); the first run "
           "compiles the tube kernels (cached afterwards)")
     res = ro.solve(meas, dt=args.dt, rel_eps=args.rel_eps, max_iter=args.max_iter)
@@ -40,11 +40,12 @@ def run(args: argparse.Namespace) -> int:
         truth = ro.RobotTruth() if args.data is None else None
         fig, ax = plt.subplots(figsize=(9, 4))
         plot_range_only_diagonal(res, ax=ax)
-        ax.set_title(f"position-box diagonal per iteration (seed 001, Fig. 8), dt = {args.dt:g}")
+        ax.set_title(f"position-box diagonal per iteration (Rohou et al. 2018, Fig. 8), "
+                     f"dt = {args.dt:g}")
         save_figure(fig, args.out, "range_only_diagonal")
         fig, ax = plt.subplots(figsize=(9, 7))
         plot_range_only_map(res, truth=truth, ax=ax)
-        ax.set_title("[x1](.) x [x2](.) among the beacons (seed 001, Fig. 9)")
+        ax.set_title("[x1](.) x [x2](.) among the beacons (Rohou et al. 2018, Fig. 9)")
         save_figure(fig, args.out, "range_only_map")
     write_json(res.to_json(), args.json)
     return 1 if res.empty else 0
@@ -52,7 +53,8 @@ def run(args: argparse.Namespace) -> int:
 
 def register(runs: argparse._SubParsersAction) -> None:
     """Add ``boundest run range-only`` and its options."""
-    p = runs.add_parser("range-only", help="seed 001: range-only robot with uncertain times")
+    p = runs.add_parser("range-only",
+                        help="Rohou et al. 2018: range-only robot with uncertain times")
     p.add_argument("--dt", type=float, default=0.01, help="slice duration (default 0.01)")
     p.add_argument("--data", help="measurement CSV, columns i,beacon,t_lo,t_hi,z_lo,z_hi "
                    "(default: the embedded Table 1; docs/data-format.md)")

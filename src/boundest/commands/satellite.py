@@ -1,4 +1,4 @@
-"""``boundest run satellite``: seed 000 end to end, with the Fig. 4 picture."""
+"""``boundest run satellite``: Jaulin 2002 end to end, with the Fig. 4 picture."""
 
 from __future__ import annotations
 
@@ -17,7 +17,7 @@ def run(args: argparse.Namespace) -> int:
     from ..scenarios import satellite as sat
 
     meas = sat.load(args.data, k_max=args.kmax)
-    print(f"satellite (seed 000): k_max = {meas.k_max}, data {meas.source}")
+    print(f"satellite (Jaulin 2002): k_max = {meas.k_max}, data {meas.source}")
     print(f"CSP: {7 * (meas.k_max + 1)} constraints over {11 * meas.k_max + 15} variables; "
           "first run compiles the propagation kernel (cached afterwards)")
     res = sat.solve(meas, rel_eps=args.rel_eps)
@@ -46,7 +46,7 @@ def run(args: argparse.Namespace) -> int:
         ax.set_xlabel("x1")
         ax.set_ylabel("x2")
         ax.set_aspect("equal")
-        ax.set_title(f"[x1](k) x [x2](k), k = 0..{meas.k_max + 1} (seed 000, Fig. 4)")
+        ax.set_title(f"[x1](k) x [x2](k), k = 0..{meas.k_max + 1} (Jaulin 2002, Fig. 4)")
         ax.legend()
         save_figure(fig, args.out, f"satellite_k{meas.k_max}")
     write_json(res.to_json(), args.json)
@@ -55,7 +55,7 @@ def run(args: argparse.Namespace) -> int:
 
 def register(runs: argparse._SubParsersAction) -> None:
     """Add ``boundest run satellite`` and its options."""
-    sat = runs.add_parser("satellite", help="seed 000: satellite localisation as a CSP")
+    sat = runs.add_parser("satellite", help="Jaulin 2002: satellite localisation as a CSP")
     sat.add_argument("--kmax", type=int, choices=(200, 800), default=None,
                      help="horizon (default: 200, or every row of --data)")
     sat.add_argument("--data", help="measurement CSV, columns k,y1_lo,y1_hi,y2_lo,y2_hi,"

@@ -1,4 +1,4 @@
-"""Beta-tuning (seed 000 section 5.2): the smallest relaxation that keeps a CSP non-empty."""
+"""Beta-tuning (Jaulin 2002 section 5.2): the smallest relaxation that keeps a CSP non-empty."""
 
 from __future__ import annotations
 

@@ -1,11 +1,12 @@
-"""Tree-structured set CSPs: the FALL and CLIMB algorithms of seed 002 (section 3.2).
+"""Tree-structured set CSPs: the FALL and CLIMB algorithms of Jaulin et al. 2001 (section 3.2).
 
 A set constraint satisfaction problem (SCSP) has one *domain* per variable (any set
 representation: a box, a subpaving, a finite set...) and binary constraints. When its graph is a
 tree, one FALL (leaves to root) followed by one CLIMB (root to leaves) gives its optimal
-contraction (seed 002, Theorem 6), provided the local contraction operators are exact:
+contraction (Jaulin et al. 2001, Theorem 6), provided the local contraction operators are exact:
 
-    rho_b(V_a) = {v_a in V_a | exists v_b in V_b, (v_a, v_b) in C_ab}      (seed 002, eq. 9)
+    rho_b(V_a) = {v_a in V_a | exists v_b in V_b, (v_a, v_b) in C_ab}      (Jaulin et al. 2001,
+    eq. 9)
 
 This module knows nothing about the domains: each ``Arc`` carries its two local operators as
 callables, ``toward_a(V_a, V_b) -> V_a'`` and ``toward_b(V_b, V_a) -> V_b'``. With outer
@@ -126,7 +127,8 @@ class TreeSCSP:
         return {v: domains[v] for v in self.variables}
 
     def fall(self, domains: Mapping[Hashable, Any], root: Hashable) -> dict[Hashable, Any]:
-        """FALL (seed 002, section 3.2.2): contract every domain by its sons, from the leaves
+        """FALL (Jaulin et al. 2001, section 3.2.2): contract every domain by its sons, from the
+        leaves
         down to ``root``. The result is up-consistent; the root's domain is its projection."""
         out = self._check(domains)
         for p, _, arc in reversed(self.rooted(root)):  # all sons of c are done before c -> p
@@ -134,7 +136,8 @@ class TreeSCSP:
         return out
 
     def climb(self, domains: Mapping[Hashable, Any], root: Hashable) -> dict[Hashable, Any]:
-        """CLIMB (seed 002, section 3.2.3): contract every son by its father, from ``root`` up
+        """CLIMB (Jaulin et al. 2001, section 3.2.3): contract every son by its father, from
+        ``root`` up
         to the leaves. On an up-consistent SCSP this gives the optimal contraction."""
         out = self._check(domains)
         for _, c, arc in self.rooted(root):
@@ -144,14 +147,16 @@ class TreeSCSP:
     def fall_climb(self, domains: Mapping[Hashable, Any], root: Hashable | None = None
                    ) -> dict[Hashable, Any]:
         """FALL then CLIMB from ``root`` (default: the first variable): the optimal contraction
-        (seed 002, Theorem 6) when the local operators are exact, an outer one otherwise."""
+        (Jaulin et al. 2001, Theorem 6) when the local operators are exact, an outer one
+        otherwise."""
         root = self.variables[0] if root is None else root
         return self.climb(self.fall(domains, root), root)
 
     def waltz(self, domains: Mapping[Hashable, Any], equal: Callable[[Any, Any], bool], *,
               seed: int | None = None, max_rounds: int = 10_000
               ) -> tuple[dict[Hashable, Any], int]:
-        """The Waltz algorithm (seed 002, section 2): apply the local operators in a random
+        """The Waltz algorithm (Jaulin et al. 2001, section 2): apply the local operators in a
+        random
         order (``seed``) until a whole round changes no domain (``equal(old, new)``).
 
         Returns the domains and the number of rounds. On a tree with exact operators it reaches

@@ -1,6 +1,6 @@
-"""Causal and non-causal set state estimation of seed 002 (section 4): CSE, RCSE and NCSE.
+"""Causal and non-causal set state estimation of Jaulin et al. 2001 (section 4): CSE, RCSE and NCSE.
 
-The system is ``x_k = f_k(x_{k-1})``, ``y_k = g_k(x_k)``, ``k = 1..K``. Its SCSP (seed 002
+The system is ``x_k = f_k(x_{k-1})``, ``y_k = g_k(x_k)``, ``k = 1..K``. Its SCSP (Jaulin et al. 2001
 eq. 20) is a tree: the chain ``x_0 - x_1 - ... - x_K`` with a leaf ``y_k`` on each ``x_k``. The
 estimators are FALL/CLIMB schedules on it (``boundest.csp.tree``), with the local operators of
 ``boundest.estimation.setops`` on one of two kinds of domains:
@@ -8,9 +8,10 @@ estimators are FALL/CLIMB schedules on it (``boundest.csp.tree``), with the loca
 ``domains="boxes"``       hull consistency by forward-backward contractors; fast; batched: the
                           measurements may carry leading batch dimensions ``(..., K, ny)`` (one
                           independent problem each, e.g. many simulated runs at once);
-``domains="subpavings"``  the optimal set estimators of seed 002 (up to the precision ``eps``).
+``domains="subpavings"``  the optimal set estimators of Jaulin et al. 2001 (up to the precision
+``eps``).
 
-Example (seed 002 equation 21, three steps from x(0) = (0, 0), boxes):
+Example (Jaulin et al. 2001 equation 21, three steps from x(0) = (0, 0), boxes):
 
 >>> import boundest as bd
 >>> sys = DiscreteSystem(lambda x: [3 * bd.sin(x[0] + x[1]), 3 * bd.cos(x[0] + x[1])],
@@ -122,7 +123,7 @@ def _yn(k: int) -> tuple[str, int]:
 
 def _chain(system: DiscreteSystem, K: int, ops: BoxSets | PavingSets,
            tick: Callable[[], None]) -> TreeSCSP:
-    """The SCSP of seed 002 eq. 20 with the local operators of ``ops``."""
+    """The SCSP of Jaulin et al. 2001 eq. 20 with the local operators of ``ops``."""
     arcs = []
 
     def arc(a: tuple, b: tuple, m: Map) -> Arc:  # b = m(a)
@@ -205,7 +206,7 @@ def ncse(system: DiscreteSystem, y: Interval, *, x0: Interval | None = None,
         x_prior: Interval | None = None,
          y_prior: Interval | None = None, domains: str = "boxes", eps: float = 0.01,
          max_boxes: int = 2_000_000, progress: bool = False) -> ChainEstimate:
-    """Non-causal state estimator NCSE (seed 002 section 4): FALL-CLIMB from ``x_K``.
+    """Non-causal state estimator NCSE (Jaulin et al. 2001 section 4): FALL-CLIMB from ``x_K``.
 
     Parameters
     ----------
@@ -261,11 +262,11 @@ def rcse(system: DiscreteSystem, y: Interval, *, x0: Interval | None = None,
         x_prior: Interval | None = None,
          y_prior: Interval | None = None, domains: str = "boxes", eps: float = 0.01,
          max_boxes: int = 2_000_000, progress: bool = False) -> ChainEstimate:
-    """Recursive causal state estimator RCSE (seed 002 section 4).
+    """Recursive causal state estimator RCSE (Jaulin et al. 2001 section 4).
 
     Same parameters as ``ncse``. ``x[k]`` of the result is the causal set of ``x_k`` given
     ``y_1..y_k`` (``x[0]``: given none), ``y[k - 1]`` that of ``y_k``; both are consistent with
-    the whole SCSP at time ``k`` (seed 002, Theorem 8).
+    the whole SCSP at time ``k`` (Jaulin et al. 2001, Theorem 8).
     """
     K, ops, xs, ys, meas = _setup(system, y, x0, x_prior, y_prior, domains, eps, max_boxes)
     tick, bar = _progress(3 * K, "RCSE", progress)
@@ -290,7 +291,8 @@ def cse(system: DiscreteSystem, y: Interval, *, x0: Interval | None = None,
         x_prior: Interval | None = None,
         y_prior: Interval | None = None, domains: str = "boxes", eps: float = 0.01,
         max_boxes: int = 2_000_000) -> list[ChainEstimate]:
-    """Causal state estimator CSE (seed 002 section 4): after each measurement ``y_k``, CLIMB
+    """Causal state estimator CSE (Jaulin et al. 2001 section 4): after each measurement ``y_k``,
+    CLIMB
     from ``y_k`` makes the whole SCSP minimal (Theorem 7).
 
     Same parameters as ``ncse``. Returns ``K + 1`` estimates: entry ``k`` holds the domains of

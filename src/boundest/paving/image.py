@@ -1,4 +1,4 @@
-"""Image of a subpaving by a function: IMAGESP (seed 002, Remark 3).
+"""Image of a subpaving by a function: IMAGESP (Jaulin et al. 2001, Remark 3).
 
 ``image(sp, f, eps)`` bisects the boxes of ``sp`` (all at once, level by level) until each image
 box ``f([x])`` has its widest side at most ``eps``, then paves the union of the image boxes on a
@@ -14,7 +14,7 @@ Examples
 --------
 >>> from boundest import interval as iv
 >>> from boundest.interval import Interval
->>> def f(x):  # x -> 3 (sin(x1 + x2), cos(x1 + x2)), seed 002 equation 21
+>>> def f(x):  # x -> 3 (sin(x1 + x2), cos(x1 + x2)), Jaulin et al. 2001 equation 21
 ...     s = x[:, 0] + x[:, 1]
 ...     return Interval._new(np.stack([(3 * iv.sin(s)).lo, (3 * iv.cos(s)).lo], axis=1),
 ...                          np.stack([(3 * iv.sin(s)).hi, (3 * iv.cos(s)).hi], axis=1))

@@ -1,4 +1,4 @@
-"""Set estimates of a state over time: one panel per time step (seed 002 Fig. 7)."""
+"""Set estimates of a state over time: one panel per time step (Jaulin et al. 2001 Fig. 7)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""The figures of seed 001: range-only robot (Figs. 8-9) and drifting clock (Figs. 11-12).
+"""The figures of Rohou et al. 2018: range-only robot (Figs. 8-9) and drifting clock (Figs. 11-12).
 
 Each function takes a result of :mod:`boundest.scenarios.range_only` or
 :mod:`boundest.scenarios.drifting_clock`, ``ax=None`` and an optional truth, and returns the
@@ -25,7 +25,8 @@ __all__ = ["plot_clock_distance", "plot_clock_drift", "plot_range_only_diagonal"
 
 def plot_range_only_diagonal(res: RangeOnlyResult, ax: Any = None,
                              cmap: str = "viridis") -> list[Any]:
-    """Seed 001 Fig. 8: the position-box diagonal ``d(t)`` after each iteration (log scale),
+    """Rohou et al. 2018 Fig. 8: the position-box diagonal ``d(t)`` after each iteration (log
+    scale),
     with the measurement time intervals ``[t_i]`` shaded in grey."""
     import matplotlib as mpl
 
@@ -49,7 +50,8 @@ def plot_range_only_diagonal(res: RangeOnlyResult, ax: Any = None,
 
 def plot_range_only_map(res: RangeOnlyResult, truth: RobotTruth | None = None, ax: Any = None,
                         range_max: float = 20.0) -> list[Any]:
-    """Seed 001 Fig. 9: the tube ``[x1](.) x [x2](.)`` projected on the plane (slice boxes),
+    """Rohou et al. 2018 Fig. 9: the tube ``[x1](.) x [x2](.)`` projected on the plane (slice
+    boxes),
     the positions over the contracted ``[t_i]`` darker, the beacons with their range circles and
     the true path."""
     from matplotlib.patches import Circle, Rectangle
@@ -87,7 +89,7 @@ def plot_range_only_map(res: RangeOnlyResult, truth: RobotTruth | None = None, a
 
 def plot_clock_distance(res: ClockResult, truth: ClockTruth | None = None,
                         ax: Any = None) -> list[Any]:
-    """Seed 001 Fig. 11: the ephemeris tube ``[y](.)`` with the measurements before (blue:
+    """Rohou et al. 2018 Fig. 11: the ephemeris tube ``[y](.)`` with the measurements before (blue:
     ``[h]^{-1}(tau_i) x [z_i]`` from the derivative bounds alone) and after (red) contraction."""
     ax = _axes(ax)
     artists = plot_tube(res.y, ax=ax, color="tab:grey", alpha=0.4, gates=False,
@@ -103,7 +105,8 @@ def plot_clock_distance(res: ClockResult, truth: ClockTruth | None = None,
 
 def plot_clock_drift(res: ClockResult, truth: ClockTruth | None = None,
                      ax: Any = None) -> list[Any]:
-    """Seed 001 Fig. 12: the drift tube ``[h](.)``, the enclosures ``[t_i]`` of the reference
+    """Rohou et al. 2018 Fig. 12: the drift tube ``[h](.)``, the enclosures ``[t_i]`` of the
+    reference
     times at each ``tau_i`` and the true drift."""
     ax = _axes(ax)
     artists = plot_tube(res.h, ax=ax, color="tab:grey", alpha=0.45, gates=False,

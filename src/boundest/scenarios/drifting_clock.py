@@ -1,4 +1,4 @@
-"""The drifting clock of seed 001 (section 5, equations 16-22, Table 2).
+"""The drifting clock of Rohou et al. 2018 (section 5, equations 16-22, Table 2).
 
 An underwater beacon at ``(0, 0, -10)`` keeps a clock ``tau = h(t)`` that drifts from the
 reference time ``t`` (the truth, unknown to the solver, is ``h(t) = 0.045 t^2 + 0.98 t``, eq. 16)
@@ -257,7 +257,7 @@ class ClockResult:
         def fl(a: ArrayLike) -> list:
             return np.asarray(a, dtype=float).tolist()
         return {
-            "scenario": "drifting clock (seed 001, section 5)",
+            "scenario": "drifting clock (Rohou et al. 2018, section 5)",
             "source": self.meas.source,
             "consistent": self.consistent,
             "iterations": self.iterations,

@@ -1,10 +1,12 @@
-"""Seed 002 test case (section 5, equation 21): causal and non-causal set state estimation.
+"""Jaulin et al. 2001 test case (section 5, equation 21): causal and non-causal set state
+estimation.
 
     x(k) = 3 (sin(x1(k-1) + x2(k-1)), cos(x1(k-1) + x2(k-1))),   y(k) = |x1(k)|,   k = 1..10
 
 with measurement sets ``Y(k) = y_m(k) + [-0.1, 0.1]`` (embedded ``jaulin2001.csv``: columns k,
 y_lo, y_hi). All domains start as ``R^2`` and ``R``. For subpavings, ``x(0)`` is paved in the
-frame ``[-4, 4]^2`` of seed 002 Fig. 7: this changes no other set, because ``x1 + x2`` spans
+frame ``[-4, 4]^2`` of Jaulin et al. 2001 Fig. 7: this changes no other set, because ``x1 + x2``
+spans
 ``[-8, 8]``, more than a period, so ``f([-4, 4]^2) = f(R^2)`` (the whole circle of radius 3).
 """
 
@@ -26,14 +28,14 @@ from ._data import check_index, embedded, read_csv
 __all__ = ["FRAME", "NOISE", "Jaulin2001", "Simulation", "load", "simulate", "solve", "system",
            "to_json"]
 
-#: the frame of seed 002 Fig. 7, also the prior of x(0) for subpavings
+#: the frame of Jaulin et al. 2001 Fig. 7, also the prior of x(0) for subpavings
 FRAME = Interval([-4.0, -4.0], [4.0, 4.0])
 #: bound of the measurement noise
 NOISE = 0.1
 
 
 def system() -> DiscreteSystem:
-    """The system of seed 002 equation 21."""
+    """The system of Jaulin et al. 2001 equation 21."""
     return DiscreteSystem(lambda x: [3 * _sin(x[0] + x[1]), 3 * _cos(x[0] + x[1])],
                           lambda x: [abs(x[0])], nx=2, ny=1)
 

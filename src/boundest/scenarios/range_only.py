@@ -1,4 +1,4 @@
-"""The range-only robot of seed 001 (section 4, equations 13-15, Table 1).
+"""The range-only robot of Rohou et al. 2018 (section 4, equations 13-15, Table 1).
 
 State ``x = (x1, x2, x3, x4)``: position, heading ``psi`` and speed ``theta``::
 
@@ -265,7 +265,8 @@ class RangeOnlyResult:
 
     ``x``, ``v``: 4-D tubes of the state and its derivative; ``y``, ``w``: K-D tubes of the
     distances to the beacons and their derivatives; ``t``, ``z``: the contracted measurement
-    intervals; ``diag[k]``: the position-box diagonal ``d`` (seed 001 Fig. 8) at the gate times
+    intervals; ``diag[k]``: the position-box diagonal ``d`` (Rohou et al. 2018 Fig. 8) at the gate
+    times
     ``diag_t`` after iteration ``k``.
     """
 
@@ -308,7 +309,7 @@ class RangeOnlyResult:
             return np.asarray(a, dtype=float).tolist()
         d = self.position_diagonal()
         return {
-            "scenario": "range-only robot (seed 001, section 4)",
+            "scenario": "range-only robot (Rohou et al. 2018, section 4)",
             "source": self.meas.source,
             "consistent": self.consistent,
             "iterations": self.iterations,
@@ -411,7 +412,7 @@ def solve(meas: Measurements | None = None, dt: float = 0.01, rel_eps: float = 1
     stops when an iteration decreases the total width of its domains by less than ``rel_eps``
     (relative) while bounding no new bound, after ``max_iter`` iterations, or when a domain
     becomes empty (the data contradict the model). ``iterations`` counts the position
-    network's iterations (seed 001's Fig. 8 steps).
+    network's iterations (Rohou et al. 2018's Fig. 8 steps).
     """
     meas = load() if meas is None else meas
     if not (np.isfinite(dt) and dt > 0):

@@ -1,4 +1,4 @@
-"""The satellite of seed 000 (equations 14-16, Remarks 2-3): state estimation as a CSP.
+"""The satellite of Jaulin 2002 (equations 14-16, Remarks 2-3): state estimation as a CSP.
 
 State ``x = (x1, x2, x3, x4)`` (position and velocity), Euler step ``delta = 0.5``::
 
@@ -150,7 +150,7 @@ def _scaled_outputs(meas: Measurements, beta: float) -> tuple[np.ndarray, np.nda
 
 def build_model(meas: Measurements, beta: float = 1.0, w_bound: float = W_BOUND) -> Model:
     """The CSP of equations 14-16, with perturbation and output intervals scaled by ``beta``
-    (seed 000 section 5.2: ``[w] = beta [w]``, ``[y] = mid + beta ([y] - mid)``)."""
+    (Jaulin 2002 section 5.2: ``[w] = beta [w]``, ``[y] = mid + beta ([y] - mid)``)."""
     if beta <= 0:
         raise ValueError(f"beta must be positive, got {beta}")
     K = meas.k_max
@@ -189,9 +189,9 @@ def _domain_text(lo: float, hi: float) -> str:
 
 
 def model_text(meas: Measurements) -> str:
-    """The same CSP in the model text format (RealPaver-like, seed 000 section 4)."""
+    """The same CSP in the model text format (RealPaver-like, Jaulin 2002 section 4)."""
     K = meas.k_max
-    lines = ["// Satellite of seed 000 (equations 14-16), written by boundest", "Variables"]
+    lines = ["// Satellite of Jaulin 2002 (equations 14-16), written by boundest", "Variables"]
     decl = []
     names = ("x1_0", "x2_0", "x3_0", "x4_0")
     doms = ("[0, +oo[", "[0, +oo[", "]-oo, 0]", "[0, +oo[")
@@ -277,7 +277,7 @@ def solve(meas: Measurements, rel_eps: float = 1e-3, progress: bool | None = Non
 
 def tune(meas: Measurements, beta_max: float = 16.0, tol: float = 1e-3, rel_eps: float = 1e-3
          ) -> tuple[BetaResult, SatelliteResult]:
-    """Beta-tuning (seed 000 section 5.2): the smallest ``beta`` in ``]0, beta_max]`` for which
+    """Beta-tuning (Jaulin 2002 section 5.2): the smallest ``beta`` in ``]0, beta_max]`` for which
     the contracted CSP is not empty, and the domains at that ``beta``."""
     K = meas.k_max
     tape = compile_model(build_model(meas, beta=beta_max))

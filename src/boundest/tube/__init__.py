@@ -1,5 +1,5 @@
 """Sliced tubes and their contractors: derivative, evaluation with uncertain times, algebraic
-constraints on every slice, and a contractor network (seed 001)."""
+constraints on every slice, and a contractor network (Rohou et al. 2018)."""
 
 from .deriv import CtcDeriv
 from .eval import CtcEval

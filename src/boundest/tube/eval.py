@@ -1,6 +1,6 @@
 """CtcEval: the evaluation constraint ``z = y(t)`` with ``t ∈ [t]``, ``z ∈ [z]``, ``y' ∈ [w]``.
 
-Seed 001 Proposition 2:
+Rohou et al. 2018 Proposition 2:
 
 - ``[t] ← [t] ∩ [y]^{-1}([z])`` (hull of the time slices and gates where the tube meets ``[z]``);
 - ``[z] ← [z] ∩ [y]([t])``;
@@ -197,7 +197,7 @@ def eval_kernel(t: NDArray, slo: NDArray, shi: NDArray, glo: NDArray, ghi: NDArr
 
 
 class CtcEval:
-    """Contractor for ``z = y(t)``, ``t ∈ [t]``, ``z ∈ [z]``, ``y'(.) ∈ [w](.)`` (seed 001
+    """Contractor for ``z = y(t)``, ``t ∈ [t]``, ``z ∈ [z]``, ``y'(.) ∈ [w](.)`` (Rohou et al. 2018
     Proposition 2).
 
     ``contract(t, z, y, w)`` contracts the scalar intervals ``t`` and ``z`` and the tube ``y`` in

@@ -1,5 +1,5 @@
 """Elementary functions of tubes: the interval function on all slices and gates at once
-(``boundest.tube.functions.sin(x)`` is the tube of ``sin(x(.))``, seed 001 section 2.2)."""
+(``boundest.tube.functions.sin(x)`` is the tube of ``sin(x(.))``, Rohou et al. 2018 section 2.2)."""
 
 from __future__ import annotations
 

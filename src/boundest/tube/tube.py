@@ -403,7 +403,8 @@ class Tube:
 
     def inverse(self, z: Interval | ArrayLike, hull: bool = False,
                 within: Interval | None = None) -> list[Interval] | Interval:
-        """``[y]^{-1}([z])``: the times at which the tube may take a value in ``[z]`` (seed 001
+        """``[y]^{-1}([z])``: the times at which the tube may take a value in ``[z]`` (Rohou et
+        al. 2018
         Fig. 5), as a list of disjoint time intervals in increasing order (or their hull).
 
         A run of consecutive slices meeting ``[z]`` gives one interval, split where the gate
