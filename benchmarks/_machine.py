@@ -13,3 +13,14 @@ def cpu_model() -> str | None:
     except OSError:
         pass
     return None
+
+
+def emit(doc: dict, out: str | None) -> None:
+    """Print the benchmark's JSON document on stdout and write it to ``out`` (if given)."""
+    import json
+    from pathlib import Path
+
+    text = json.dumps(doc, indent=1, default=float)
+    print(text)
+    if out:
+        Path(out).write_text(text + "\n")

@@ -37,7 +37,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from _machine import cpu_model
+from _machine import cpu_model, emit
 from _subprocess import run_json_script
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -240,10 +240,7 @@ def main() -> int:
         rec["codac2"] = "not run (no .bench-venv-codac2 or --no-codac)"
     rec["loadavg_end"] = os.getloadavg()
     rec["children_maxrss_mb"] = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
-    text = json.dumps(rec, indent=1, default=float)
-    print(text)
-    if args.out:
-        Path(args.out).write_text(text + "\n")
+    emit(rec, args.out)
     return 0
 
 

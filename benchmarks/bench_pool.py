@@ -23,18 +23,16 @@ JSON goes to stdout (and to ``--out``); progress goes to stderr.
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import os
 import platform
 import statistics
 import sys
 import time
-from pathlib import Path
 from typing import Any
 
 import numpy as np
-from _machine import cpu_model
+from _machine import cpu_model, emit
 
 
 def log(msg: str) -> None:
@@ -143,10 +141,7 @@ def main() -> int:
             np.array([c[1] for c in ci]) < bound)),
     }
     rec["loadavg_end"] = os.getloadavg()
-    text = json.dumps(rec, indent=1, default=float)
-    print(text)
-    if args.out:
-        Path(args.out).write_text(text + "\n")
+    emit(rec, args.out)
     return 0
 
 

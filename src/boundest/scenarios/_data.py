@@ -34,9 +34,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .._textfile import read_text as _read_text
+from ..interval import Interval
 
-__all__ = ["KINDS", "DataError", "Table", "check_index", "check_sorted", "embedded", "read_csv",
-           "read_text"]
+__all__ = ["KINDS", "DataError", "Table", "check_index", "check_sorted", "embedded", "outward",
+           "read_csv", "read_text", "sample_index"]
 
 #: the column kinds understood by :func:`read_csv`
 KINDS = ("text", "finite", "lo", "hi")
@@ -244,3 +245,23 @@ def check_sorted(table: Table, column: str, strict: bool) -> None:
         raise table.error(j, f"{column} = {float(v[j])!r} {rel} {float(v[j - 1])!r} on line "
                              f"{int(table.lines[j - 1])} (rows must be sorted by {column}"
                              f"{', each value once' if strict else ''})")
+
+
+def outward(lo: NDArray, hi: NDArray) -> Interval:
+    """One ulp outward: encloses the decimal numbers that ``lo``, ``hi`` were parsed from."""
+    return Interval._new(np.nextafter(lo, -np.inf), np.nextafter(hi, np.inf))
+
+
+def sample_index(table: Table, t0: float, dt: float, n: int, column: str = "t"
+                 ) -> NDArray[np.intp]:
+    """``k = round((t - t0) / dt)`` of every row, checked to lie on the grid (to 1e-6 dt) and in
+    ``0 .. n - 1``; a :class:`DataError` names the first row that does not."""
+    t = table[column]
+    kf = (t - t0) / dt
+    k = np.rint(kf)
+    bad = np.flatnonzero((np.abs(kf - k) > 1e-6) | (k < 0) | (k > n - 1))
+    if bad.size:
+        j = int(bad[0])
+        raise table.error(j, f"{column} = {float(t[j])!r} is not a sample time t0 + k dt "
+                             f"(t0 = {t0!r}, dt = {dt!r}, k = 0..{n - 1})")
+    return k.astype(np.intp)

@@ -21,7 +21,16 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..interval import Interval
-from ._data import DataError, check_index, check_sorted, embedded, read_csv, read_text
+from ._data import (
+    DataError,
+    check_index,
+    check_sorted,
+    embedded,
+    outward,
+    read_csv,
+    read_text,
+    sample_index,
+)
 
 __all__ = ["AuvData", "load_auv"]
 
@@ -95,28 +104,10 @@ class AuvData:
                 f"detections={self.det_k.size}, mines={self.n_mines}, source={self.source!r})")
 
 
-def _outward(lo: NDArray, hi: NDArray) -> Interval:
-    """One ulp outward: encloses the decimal numbers that ``lo``, ``hi`` were parsed from."""
-    return Interval._new(np.nextafter(lo, -np.inf), np.nextafter(hi, np.inf))
-
-
 def _pairs(table, names: tuple[str, ...]) -> Interval:
     lo = np.stack([table[f"{q}_lo"] for q in names], axis=-1)
     hi = np.stack([table[f"{q}_hi"] for q in names], axis=-1)
-    return _outward(lo, hi)
-
-
-def _sample_index(table, t0: float, dt: float, n: int) -> NDArray[np.intp]:
-    """``k = round((t - t0) / dt)``, checked to lie on the grid (to 1e-6 dt) and in range."""
-    t = table["t"]
-    kf = (t - t0) / dt
-    k = np.rint(kf)
-    bad = np.flatnonzero((np.abs(kf - k) > 1e-6) | (k < 0) | (k > n - 1))
-    if bad.size:
-        j = int(bad[0])
-        raise table.error(j, f"t = {float(t[j])!r} is not a sample time t0 + k dt "
-                             f"(t0 = {t0!r}, dt = {dt!r}, k = 0..{n - 1})")
-    return k.astype(np.intp)
+    return outward(lo, hi)
 
 
 def load_auv(folder: str | Path | None = None) -> AuvData:
@@ -149,17 +140,17 @@ def load_auv(folder: str | Path | None = None) -> AuvData:
     if len(sensors) != n:
         raise sensors.error(len(sensors) - 1, f"{len(sensors)} samples, but {setup_path.name} "
                                               f"says n_samples = {n}")
-    k = _sample_index(sensors, t0, dt, n)
+    k = sample_index(sensors, t0, dt, n)
     sensors.columns["k"] = k.astype(np.float64)
     check_index(sensors, "k", 0)
 
     gps = read_csv(base / setup["gps_file"], _GPS_COLUMNS)
     check_sorted(gps, "t", strict=True)
-    fix_k = _sample_index(gps, t0, dt, n)
+    fix_k = sample_index(gps, t0, dt, n)
 
     det = read_csv(base / setup["detection_file"], _DETECTION_COLUMNS)
     check_sorted(det, "t", strict=False)
-    det_k = _sample_index(det, t0, dt, n)
+    det_k = sample_index(det, t0, dt, n)
     n_mines = int(setup["n_mines"])
     mine = det["mine_id"]
     bad = np.flatnonzero((mine != np.rint(mine)) | (mine < 0) | (mine >= n_mines))

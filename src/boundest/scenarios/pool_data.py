@@ -32,7 +32,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..ctc.obstacles import ObstacleMap
 from ..interval import Interval
-from ._data import DataError, Table, check_index, read_csv, read_text
+from ._data import DataError, Table, check_index, outward, read_csv, read_text
 from ._data import embedded as _embedded
 
 __all__ = ["STATE", "PoolData", "binomial_bound", "euler_step", "load_pool"]
@@ -172,11 +172,6 @@ def binomial_bound(m: int, q: int, p: float) -> float:
     return float(total)
 
 
-def _outward(lo: NDArray, hi: NDArray) -> Interval:
-    """One ulp outward: encloses the decimal numbers that ``lo``, ``hi`` were parsed from."""
-    return Interval._new(np.nextafter(lo, -np.inf), np.nextafter(hi, np.inf))
-
-
 def _grid(table: Table, t0: float, dt: float, n: int, setup: Path) -> None:
     """Rows at ``t0, t0 + dt, ...`` in order (to 1e-6 dt), exactly ``n`` of them."""
     t = table["t"]
@@ -220,7 +215,7 @@ def _initial_box(setup: dict[str, Any], path: Path) -> Interval:
             raise DataError(f"{path}: initial_state_box.{name} must be [lo, hi] with finite "
                             f"lo <= hi, got {b!r}")
         lo[i], hi[i] = b
-    return _outward(lo, hi)
+    return outward(lo, hi)
 
 
 def load_pool(folder: str | Path | None = None) -> PoolData:
@@ -285,9 +280,9 @@ def load_pool(folder: str | Path | None = None) -> PoolData:
     sonar = read_csv(base / setup["sonar_file"], _SONAR_COLUMNS)
     _grid(sonar, t0, dt, n, setup_path)
     # both files now hold the rows k = 0 .. n - 1 in order: the same times
-    u = _outward(np.stack([inputs["u1_lo"], inputs["u2_lo"]], axis=-1),
+    u = outward(np.stack([inputs["u1_lo"], inputs["u2_lo"]], axis=-1),
                  np.stack([inputs["u1_hi"], inputs["u2_hi"]], axis=-1))
     return PoolData(t0=t0, dt=dt, inputs=u, alpha=np.ascontiguousarray(sonar["alpha"]),
-                    ranges=_outward(sonar["d_lo"], sonar["d_hi"]), x0=x0, map=pool_map,
+                    ranges=outward(sonar["d_lo"], sonar["d_hi"]), x0=x0, map=pool_map,
                     p_outlier=p, max_range=max_range,
                     source=str(base) if folder is not None else "embedded")

@@ -35,7 +35,7 @@ from ..expr import Var
 from ..expr import functions as ef
 from ..interval import Interval
 from ..tube import ContractorNetwork, CtcDeriv, CtcEval, CtcSlices, Tube, time_grid
-from ._data import check_index, check_sorted, embedded, read_csv
+from ._data import check_index, check_sorted, embedded, outward, read_csv
 
 __all__ = [
     "T0",
@@ -58,11 +58,6 @@ U_BOUND = 1e-3
 X0_TRUE = (0.0, 0.0, math.pi / 2, 0.0)
 #: Half-widths of the known initial heading and speed: x3(0) in pi/2 +- 0.01, x4(0) in +- 0.01.
 X3_0_RAD, X4_0_RAD = 0.01, 0.01
-
-
-def _outward(lo: NDArray, hi: NDArray) -> tuple[NDArray, NDArray]:
-    """One ulp outward: encloses the decimal numbers that ``lo``, ``hi`` were parsed from."""
-    return np.nextafter(lo, -np.inf), np.nextafter(hi, np.inf)
 
 
 @dataclass
@@ -142,11 +137,11 @@ def load(path: str | Path | None = None, beacons: str | Path | None = None,
         raise cols.error(j, f"beacon {cols['beacon'][j]!r} at t in [{float(tl[j])!r}, "
                             f"{float(th[j])!r}] repeats line {int(cols.lines[j - 1])} (the same "
                             "measurement twice)")
-    t = Interval._new(*_outward(cols["t_lo"], cols["t_hi"]))
+    t = outward(cols["t_lo"], cols["t_hi"])
     t = Interval._new(np.maximum(t.lo, domain[0]), np.minimum(t.hi, domain[1]))
-    z = Interval._new(*_outward(cols["z_lo"], cols["z_hi"]))
+    z = outward(cols["z_lo"], cols["z_hi"])
     bxy = np.stack([bcols["bx"], bcols["by"]], axis=1)
-    return Measurements(t, z, beacon, Interval._new(*_outward(bxy, bxy)), list(names),
+    return Measurements(t, z, beacon, outward(bxy, bxy), list(names),
                         str(path))
 
 
