@@ -14,7 +14,7 @@ Data sets (``data`` in each row says which):
 * ``k800[:K+1]``  the first K+1 rows of ``src/boundest/data/satellite_k800.csv``
                   (``load(k800, k_max=K)``), K = 100, 200, 400, 800;
 * ``k200``        ``src/boundest/data/satellite_k200.csv``, K = 200;
-* ``sim1600``     ``simulate(1600, seed=--seed)`` from the seed's x(0) = (4, 0.5, -0.2, 0.5)
+* ``sim1600``     ``simulate(1600, seed=--seed)`` from the paper's x(0) = (4, 0.5, -0.2, 0.5)
                   (the files stop at k = 800); its true states are known, so the rows also
                   check that every enclosure contains them; ``sim1600[:K+1]`` prefixes of the
                   same simulation give a same-data scaling series (``--no-same-data`` drops
@@ -451,7 +451,7 @@ def main() -> None:
                       "build_s); Codac: ContractorNetwork.contract() (network building "
                       "excluded, reported as build_s)",
             "time_min_s": "the fastest of the repeats (steadier on a loaded machine)",
-            "time_per_step_us": "time_s / k_max in microseconds (as t_c / k_max in the seed's "
+            "time_per_step_us": "time_s / k_max in microseconds (as t_c / k_max in the paper's "
                                 "Fig. 5)",
             "mean_width": "mean over k = 0..k_max of the enclosure width of each component",
             "speedup": "Codac time_s / boundest time_s (> 1: boundest faster)",

@@ -11,7 +11,7 @@ boundest is tighter).
 
 Cases: the robot at each ``--dts`` (default 0.01 and 0.001) on Table 1, and the clock at each
 ``--clock-dts`` (default 0.01 and 0.002) on Table 2 over ``[0, t_final]`` (12.44 s for Table 2
-at dt = 0.01). The seed's
+at dt = 0.01). The paper's
 truths (robot: x(0) = (0, 0, pi/2, 0) with the centre of eq. 14; clock: eq. 16) are checked
 against every enclosure (``contains_truth``, at the gate times).
 

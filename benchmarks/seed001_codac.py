@@ -19,7 +19,7 @@ range-only robot::
 
 with ``[u]`` of equation 14 (``TFunction`` enclosure inflated by 1e-3), ``x3(0) in pi/2 +
 [-0.01, 0.01]``, ``x4(0) in [-0.01, 0.01]``, every other domain unbounded. (``w_k`` is the
-seed's ``(x_12 - b_k).v_12 / y_k`` written with the bearing: the quotient form is unbounded
+paper's ``(x_12 - b_k).v_12 / y_k`` written with the bearing: the quotient form is unbounded
 while the position is, and then no measurement is ever used.)
 
 drifting clock::

@@ -704,7 +704,7 @@ def test_beta_tuning_by_hand():
 
 
 def satellite_text(k_max: int) -> tuple[str, dict[str, mpmath.mpf]]:
-    """The seed's satellite CSP in the text format, with measurements simulated exactly
+    """The paper's satellite CSP in the text format, with measurements simulated exactly
     (w = 0) from x(0) = (4, 0.5, -0.2, 0.5); returns the text and the true values."""
     with mpmath.workprec(256):
         xs = [[mpmath.mpf(4), mpmath.mpf("0.5"), mpmath.mpf("-0.2"), mpmath.mpf("0.5")]]

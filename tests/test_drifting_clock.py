@@ -1,4 +1,4 @@
-"""The drifting clock of Rohou et al. 2018 (section 5): data, truth, soundness and the seed's
+"""The drifting clock of Rohou et al. 2018 (section 5): data, truth, soundness and the paper's
 results."""
 
 from __future__ import annotations
@@ -113,7 +113,7 @@ def test_inconsistent_distance_is_proven_empty():
     assert res.empty and not res.consistent
 
 
-# -- the seed's results ---------------------------------------------------------------------
+# -- the paper's results ---------------------------------------------------------------------
 def test_seed_results():
     """Rohou et al. 2018 section 5: the fixed point within a few iterations (5 in the paper),
     every [t_i]

@@ -1,4 +1,4 @@
-"""The range-only robot of Rohou et al. 2018 (section 4): data, truth, soundness and the seed's
+"""The range-only robot of Rohou et al. 2018 (section 4): data, truth, soundness and the paper's
 results."""
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 from boundest.scenarios import range_only as ro
 from boundest.scenarios._data import DataError
 
-COARSE = 0.1  # slice duration of the soundness tests (the seed's results: dt = 0.01)
+COARSE = 0.1  # slice duration of the soundness tests (the paper's results: dt = 0.01)
 
 
 def _rk4(truth: ro.RobotTruth, t_end: float, h: float = 1e-3) -> np.ndarray:
@@ -172,7 +172,7 @@ def test_inconsistent_range_is_proven_empty():
     assert res.empty and not res.consistent
 
 
-# -- the seed's results ---------------------------------------------------------------------
+# -- the paper's results ---------------------------------------------------------------------
 def test_seed_results_at_dt_001():
     """Rohou et al. 2018 Fig. 8: fixed point reached (52 iterations in the paper), the position-box
     diagonal of the order of 10 m (5-30 m over the mission in Fig. 8), the truth inside."""

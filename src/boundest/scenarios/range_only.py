@@ -54,7 +54,7 @@ __all__ = [
 T0, TF = 0.0, 64.0
 #: Bound on the input error in equation 14.
 U_BOUND = 1e-3
-#: Initial state of the seed's simulation (only x3(0) and x4(0) are known to the solver).
+#: Initial state of the paper's simulation (only x3(0) and x4(0) are known to the solver).
 X0_TRUE = (0.0, 0.0, math.pi / 2, 0.0)
 #: Half-widths of the known initial heading and speed: x3(0) in pi/2 +- 0.01, x4(0) in +- 0.01.
 X3_0_RAD, X4_0_RAD = 0.01, 0.01
@@ -153,7 +153,7 @@ _GL_X, _GL_W = np.polynomial.legendre.leggauss(10)
 class RobotTruth:
     """One trajectory of equation 13: initial state ``x0`` and input
     ``u_j(t) = centre_j(t) + a_j sin(omega_j t + phase_j)`` (``du`` rows ``(a, omega, phase)``;
-    zero amplitudes for the seed's truth).
+    zero amplitudes for the paper's truth).
 
     ``x3`` and ``x4`` are closed-form integrals of ``u``; ``x1``, ``x2`` are integrated by
     10-point Gauss-Legendre quadrature on sub-intervals of at most ``0.05`` s (error far below
