@@ -43,12 +43,12 @@ def same(z: Interval, lo: float, hi: float) -> bool:
 
 def engine_forward(name: str, x: Interval) -> Interval:
     """Images of the scalar intervals of ``x`` through the compiled engine's forward kernel."""
-    from boundest.csp import engine
+    from boundest.ctc import revise
 
-    code = getattr(engine, name.upper())
+    code = revise.OP_CODES[name]
     buf = np.empty(4)
     lo, hi = np.empty(x.lo.size), np.empty(x.lo.size)
     for i in range(x.lo.size):
-        engine._forward(code, float(x.lo.flat[i]), float(x.hi.flat[i]), 0.0, 0.0, 0.0, buf)
+        revise._forward(code, float(x.lo.flat[i]), float(x.hi.flat[i]), 0.0, 0.0, 0.0, buf)
         lo[i], hi[i] = buf[0], buf[1]
     return Interval._new(lo, hi)
