@@ -25,6 +25,7 @@ from __future__ import annotations
 from math import comb
 from typing import Literal
 
+import numba as nb
 import numpy as np
 from numpy.typing import NDArray
 
@@ -49,25 +50,54 @@ def _check_q(q: int) -> int:
     return int(q)
 
 
-def _first_covered(lo: NDArray, hi: NDArray, k: int) -> NDArray:
-    """Along the last axis of ``N`` intervals (empty: NaN bounds), the smallest real covered by
-    at least ``k >= 1`` of them; NaN where no real is.
+@nb.njit(cache=True, error_model="numpy")
+def first_covered(lo, hi, n, k, lows, highs):
+    """The smallest real covered by at least ``k >= 1`` of the intervals ``[lo[i], hi[i]]``,
+    ``i < n`` (NaN bounds: empty, covering nothing); NaN when no real is. ``lows``/``highs``:
+    scratch of ``n`` floats.
 
-    Sweep: the ``2 N`` bounds sorted, lower bounds before upper bounds at equal coordinates
-    (the intervals are closed), a running count +1 at a lower bound and -1 at an upper bound. The
+    Sweep: the bounds sorted, lower bounds before upper bounds at equal coordinates (the
+    intervals are closed), a running count +1 at a lower bound and -1 at an upper bound. The
     count only grows at lower bounds, so the first position where it reaches ``k`` is a lower
     bound ``c``, covered by at least ``k`` intervals, and every real below ``c`` by fewer.
     """
-    empty = np.isnan(lo)
-    coord = np.concatenate([np.where(empty, np.inf, lo), np.where(empty, np.inf, hi)], axis=-1)
-    step = np.concatenate([np.where(empty, 0, 1), np.where(empty, 0, -1)], axis=-1)
-    # stable: at equal coordinates the lower bounds (indices < n) come first
-    order = np.argsort(coord, axis=-1, kind="stable")
-    count = np.cumsum(np.take_along_axis(step, order, axis=-1), axis=-1)
-    reached = count >= k
-    first = np.argmax(reached, axis=-1)[..., None]
-    c = np.take_along_axis(coord, np.take_along_axis(order, first, axis=-1), axis=-1)[..., 0]
-    return np.where(reached.any(axis=-1), c, np.nan)
+    m = 0
+    for i in range(n):
+        if lo[i] <= hi[i]:
+            lows[m] = lo[i]
+            highs[m] = hi[i]
+            m += 1
+    if m < k:
+        return np.nan
+    lows[:m].sort()
+    highs[:m].sort()
+    count, j = 0, 0
+    for i in range(m):
+        while j < m and highs[j] < lows[i]:  # upper bounds strictly before this lower bound
+            count -= 1
+            j += 1
+        count += 1
+        if count >= k:
+            return lows[i]
+    return np.nan
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _first_covered_rows(lo, hi, k):
+    n = lo.shape[1]
+    out = np.empty(lo.shape[0])
+    lows, highs = np.empty(n), np.empty(n)
+    for r in range(lo.shape[0]):
+        out[r] = first_covered(lo[r], hi[r], n, k, lows, highs)
+    return out
+
+
+def _first_covered(lo: NDArray, hi: NDArray, k: int) -> NDArray:
+    """:func:`first_covered` along the last axis of ``lo``/``hi`` (a batch on the others)."""
+    n = lo.shape[-1]
+    rows = _first_covered_rows(np.ascontiguousarray(lo, dtype=np.float64).reshape(-1, n),
+                               np.ascontiguousarray(hi, dtype=np.float64).reshape(-1, n), k)
+    return rows.reshape(lo.shape[:-1])
 
 
 def qinter(intervals: Interval, q: int, axis: int = 0) -> Interval:
@@ -99,7 +129,7 @@ def qinter(intervals: Interval, q: int, axis: int = 0) -> Interval:
     bound, upper bound = the (q+1)-th smallest upper bound" is a sound outer approximation but
     not the hull when members are disjoint: for ``[0, 1], [2, 3], [2.5, 4]`` with ``q = 1`` it
     gives ``[2, 3]``, the hull is ``[2.5, 3]``. Here each bound comes from a sweep over the
-    sorted ``2 N`` bounds (``O(N log N)``, vectorised over the batch).
+    sorted ``2 N`` bounds (``O(N log N)``, compiled, one call for the whole batch).
 
     Examples
     --------
