@@ -10,8 +10,8 @@ import pytest
 
 from boundest.estimation.robust import RobustObserver, window_probability
 from boundest.interval import Interval
-from boundest.scenarios.pool import restart_box, solve_pool
-from boundest.scenarios.pool_data import binomial_bound, load_pool
+from boundest.scenarios.pool import PoolObserver, solve_pool
+from boundest.scenarios.pool_data import PoolData, binomial_bound, load_pool
 from boundest.scenarios.pool_sim import simulate_pool
 
 
@@ -28,20 +28,98 @@ def _windows_ok(outlier: np.ndarray, m: int, q: int) -> np.ndarray:
     return ~np.maximum.accumulate(bad, axis=-1)
 
 
-@pytest.mark.parametrize("q", [4, 8])
-def test_truth_kept_while_windows_hold_at_most_q_outliers(q):
-    data, truth = missions(11, 24)
-    res = solve_pool(data, q=q, m=80)
-    inside = ((res.boxes.lo <= truth.states) & (truth.states <= res.boxes.hi)).all(-1)
-    ok = _windows_ok(truth.outlier, 80, q)
-    assert ok.any()
+def _guaranteed(outlier: np.ndarray, empty: np.ndarray, m: int, q: int) -> np.ndarray:
+    """``ok[i, k]``: every window since the observer's last restart (its last empty step at or
+    before ``k``, else the start) held at most ``q`` outliers: where the recursive set must
+    hold the truth."""
+    c = np.cumsum(outlier, axis=-1)
+    prev = np.concatenate([np.zeros_like(c[..., :m]), c[..., :-m]], axis=-1)
+    bad = (c - prev) > q
+    ok = np.zeros_like(bad)
+    for i in range(bad.shape[0]):
+        since_bad = False
+        for k in range(bad.shape[1]):
+            since_bad = bad[i, k] if empty[i, k] else (since_bad or bad[i, k])
+            ok[i, k] = not since_bad
+    return ok
+
+
+def _inside(res, truth) -> np.ndarray:
+    return ((res.boxes.lo <= truth.states) & (truth.states <= res.boxes.hi)).all(-1)
+
+
+@pytest.mark.parametrize(("q", "sweeps", "n"), [(4, 0, 48), (8, 0, 48), (4, 1, 6), (8, 1, 6)])
+def test_truth_kept_while_windows_hold_at_most_q_outliers(q, sweeps, n):
+    data, truth = missions(11, n)
+    res = solve_pool(data, q=q, m=80, sweeps=sweeps)
+    inside = _inside(res, truth)
+    ok = _guaranteed(truth.outlier, res.empty, 80, q)
+    assert ok.sum() > 80 * n  # of n x 406 steps
     assert inside[ok].all(), np.argwhere(ok & ~inside)[:5]
-    # never an empty set kept: an empty step is reported and the box is the restart box
+    # never an empty set kept: an empty step is reported and the box is a bounded set
     assert not np.isnan(res.boxes.lo).any()
-    rb = restart_box(data)
-    for i, k in np.argwhere(res.empty):
-        assert np.array_equal(res.boxes.lo[i, k], rb.lo) and np.array_equal(res.boxes.hi[i, k],
-                                                                             rb.hi)
+    assert np.isfinite(res.boxes.lo[..., :2]).all() and np.isfinite(res.boxes.hi[..., :2]).all()
+
+
+def test_pure_window_observer_holds_the_truth_when_its_window_does():
+    data, truth = missions(5, 4)
+    q = 4
+    res = solve_pool(data, q=q, m=40, carry=False)
+    c = np.cumsum(truth.outlier, axis=-1)
+    prev = np.concatenate([np.zeros_like(c[..., :40]), c[..., :-40]], axis=-1)
+    ok = (c - prev) <= q  # only this step's window matters
+    inside = _inside(res, truth)
+    assert (~ok).any() and inside[ok].all(), np.argwhere(ok & ~inside)[:5]
+    # the recursive observer carries more: never wider on average
+    rec = solve_pool(data, q=q, m=40)
+    assert np.nanmean(rec.widths()[..., :2]) <= np.nanmean(res.widths()[..., :2])
+
+
+def test_restart_recovers_from_a_window_with_too_many_outliers():
+    # q = 1 is too small for p = 0.05 and m = 80: the set empties, is reported, and the
+    # observer restarts from the window alone; the heading stays bounded (the open-loop prior)
+    data, truth = missions(3, 3)
+    res = solve_pool(data, q=1, m=80, sweeps=0)
+    assert res.empty.any()
+    assert np.isfinite(res.boxes.lo).all() and np.isfinite(res.boxes.hi).all()
+    inside = _inside(res, truth)
+    ok = _guaranteed(truth.outlier, res.empty, 80, 1)
+    assert inside[ok].all()
+
+
+def test_online_updates_are_the_offline_run():
+    data = load_pool()
+    off = solve_pool(data, q=8, m=80)
+    obs = PoolObserver(data, q=8, m=80)
+    for k in range(60):
+        u = data.inputs[k - 1] if k else None
+        box, rejected, empty = obs.update(u, float(data.alpha[k]), data.ranges[k])
+        assert np.array_equal(box.lo, off.boxes.lo[k]) and np.array_equal(box.hi,
+                                                                           off.boxes.hi[k])
+        assert rejected == off.rejected[k] and empty == off.empty[k]
+    with pytest.raises(ValueError, match="input box"):
+        obs.update(None, 0.0, data.ranges[60])
+
+
+def test_paving_keeps_the_truth_and_tightens():
+    data, truth = missions(21, 2)
+    data = PoolData(data.t0, data.dt, data.inputs[:, :160], data.alpha[:160],
+                    data.ranges[:, :160], data.x0, data.map, data.p_outlier)
+    states, outlier = truth.states[:, :160], truth.outlier[:, :160]
+    box = solve_pool(data, q=8, m=80, sweeps=0)
+    paved = solve_pool(data, q=8, m=80, sweeps=0, paving=0.3)
+    assert paved.cells.min() >= 1 and paved.paving is not None
+    ok = _guaranteed(outlier, paved.empty, 80, 8)
+    inside = ((paved.boxes.lo <= states) & (states <= paved.boxes.hi)).all(-1)
+    assert ok.sum() > 200 and inside[ok].all()
+    # every kept cell lies in its step's box, and the cells' hull is the box in (x, y)
+    cells = paved.paving
+    n = np.arange(cells.shape[-2]) < paved.cells[..., None]
+    assert (cells.lo[n][:, :2] >= paved.boxes.lo[..., None, :2].repeat(cells.shape[-2], -2)[n]
+            ).all()
+    assert paved.widths()[..., :2].mean() < box.widths()[..., :2].mean()
+    with pytest.raises(ValueError, match="paving"):
+        solve_pool(data, paving=0.0)
 
 
 def test_embedded_mission():
@@ -49,10 +127,14 @@ def test_embedded_mission():
     res = solve_pool(data, q=8, m=80)
     assert not res.empty.any() and res.rejected.max() <= 8
     w = res.widths()
-    assert np.all(np.isfinite(w)) and w[40:, :2].mean() < 2.0
+    assert np.all(np.isfinite(w)) and w[40:, :2].mean() < 1.0
+    fast = solve_pool(data, q=8, m=80, sweeps=0)
+    assert w[:, :2].mean() < fast.widths()[:, :2].mean()  # smoothing inside the window pays
     # fewer outliers allowed than the data hold: the set empties, is reported, and restarts
     strict = solve_pool(data, q=2, m=80)
-    assert strict.empty.any()
+    assert strict.empty.any() and np.isfinite(strict.boxes.lo).all()
+    with pytest.raises(ValueError, match="sweeps"):
+        solve_pool(data, q=8, m=80, sweeps=-1)
 
 
 def test_window_probability_is_the_binomial_bound():

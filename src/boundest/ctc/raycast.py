@@ -111,8 +111,9 @@ def pack_tapes(obstacles: ObstacleMap) -> RayTapes:
 
     var_slot = np.array([[t.slot_of[v] for v in _VARS] for t in tapes],
                         dtype=np.int64).reshape(-1, 4)
-    return RayTapes(cat("op", np.int64), cat("out", np.int64), cat("a", np.int64),
-                    cat("b", np.int64), cat("param", np.float64), node_ptr, cat("lo", np.float64),
+    # int32 codes and slots, as the engine's tapes: one compiled revise serves both
+    return RayTapes(cat("op", np.int32), cat("out", np.int32), cat("a", np.int32),
+                    cat("b", np.int32), cat("param", np.float64), node_ptr, cat("lo", np.float64),
                     cat("hi", np.float64), slot_ptr, var_slot,
                     np.ascontiguousarray(obstacles.segments.reshape(-1, 4), dtype=np.float64),
                     np.ascontiguousarray(obstacles.centers, dtype=np.float64).reshape(-1, 2),

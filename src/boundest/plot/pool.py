@@ -23,6 +23,7 @@ if TYPE_CHECKING:
 
 #: colours of the figures, one meaning each (every one is in a legend)
 WALL, PILLAR, BOX, PATH, KEPT, REJECTED = "k", "#8c564b", "#3182bd", "#08306b", "#fd8d3c", "0.35"
+CELL = "#31a354"
 
 
 def ping_consistency(data: PoolData, res: PoolResult) -> NDArray[np.bool_]:
@@ -49,11 +50,9 @@ def ping_consistency(data: PoolData, res: PoolResult) -> NDArray[np.bool_]:
 
 
 def window_of(res: PoolResult, k: int) -> NDArray[np.intp]:
-    """The pings of the observer's window at step ``k``: the last ``m`` ones, none before or at
-    the last restart (a restart empties the window)."""
-    restarts = np.flatnonzero(res.empty[: k + 1])
-    start = max(k - res.m + 1, int(restarts[-1]) + 1 if restarts.size else 0)
-    return np.arange(start, k + 1)
+    """The pings of the observer's window at step ``k``: the last ``m`` ones (a restart keeps
+    them: it solves the window again from the open-loop prior)."""
+    return np.arange(max(k - res.m + 1, 0), k + 1)
 
 
 def plot_pool_map(data: PoolData, ax: Any = None, legend: bool = True) -> Any:
@@ -115,6 +114,11 @@ def plot_pool_snapshot(data: PoolData, res: PoolResult, k: int,
     b = res.boxes[k]
     _rects(ax, b.lo[None, :2], b.hi[None, :2], facecolor=BOX, edgecolor=BOX, alpha=0.5, lw=1)
     ax.plot([], [], "s", color=BOX, alpha=0.6, label="(x, y) box")
+    if res.paving is not None and res.cells[k]:
+        cells = res.paving[k, : min(int(res.cells[k]), res.paving.shape[-2])]
+        _rects(ax, cells.lo[:, :2], cells.hi[:, :2], facecolor="none", edgecolor=CELL, lw=0.6)
+        ax.plot([], [], "s", mfc="none", mec=CELL,
+                label=f"paving cells kept ({int(res.cells[k])}, side <= {res.eps:g} m)")
     return ax
 
 

@@ -1,11 +1,15 @@
-"""The pool robot of Jaulin's robust set-membership observer: a recursive q-relaxed box observer
-over the sonar pings (:class:`boundest.estimation.robust.RobustObserver`).
+"""The pool robot of Jaulin's robust set-membership observer: the compiled robust observer
+(:mod:`boundest.scenarios.pool_observer`) over the sonar pings, offline or online.
 
 - prediction: the interval Euler step of ``f(X, u) = (v cos theta, v sin theta, u2 - u1,
-  u1 + u2 - v)`` with the input box of the step (exact model for these data);
+  u1 + u2 - v)`` with the input box of the step (the exact model of these data);
 - observation: the ping's first-hit constraint ``d = g(x, y, theta + alpha)``
-  (:class:`boundest.ctc.CtcRayCast` on the pool map), which contracts ``x``, ``y``, ``theta``;
-- at most ``q`` outliers among the last ``m`` pings (one sonar revolution is 80 pings).
+  (:func:`boundest.ctc.raycast.raycast_box` on the pool map), which contracts ``x``, ``y``,
+  ``theta``;
+- at most ``q`` outliers among the last ``m`` pings (one sonar revolution is 80 pings);
+- ``sweeps`` rounds of smoothing inside the window per ping (0: the plain recursive observer,
+  the fastest; each round contracts the window's past states with the later pings and brings
+  them forward again).
 """
 
 from __future__ import annotations
@@ -16,55 +20,22 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from .. import interval as iv
-from ..ctc import CtcRayCast, Fixpoint
-from ..estimation.robust import RobustObserver, window_probability
+from ..ctc.raycast import pack_tapes
 from ..interval import Interval
-from .pool_data import PoolData
+from . import pool_observer as po
+from .pool_data import PoolData, binomial_bound
 
-__all__ = ["PoolResult", "pool_observer", "restart_box", "solve_pool"]
+__all__ = ["DEFAULT_PASSES", "DEFAULT_SWEEPS", "PoolObserver", "PoolResult", "restart_box",
+           "solve_pool"]
 
-
-def _dt(dt: float) -> Interval:
-    return Interval(np.nextafter(dt, -np.inf), np.nextafter(dt, np.inf))
-
-
-def predictor(dt: float):
-    """The interval Euler step ``X + dt f(X, u)`` on boxes ``(..., 4)`` with input boxes
-    ``(..., 2)`` (``v`` written ``(1 - dt) v + dt (u1 + u2)``: one occurrence of ``v``)."""
-    h = _dt(dt)
-    one_minus = 1.0 - h
-
-    def predict(x: Interval, u: Interval) -> Interval:
-        px, py, th, v = (x[..., i] for i in range(4))
-        u1, u2 = u[..., 0], u[..., 1]
-        hv = h * v
-        out = [px + hv * iv.cos(th), py + hv * iv.sin(th), th + h * (u2 - u1),
-               one_minus * v + h * (u1 + u2)]
-        return Interval._new(np.stack([o.lo for o in out], -1), np.stack([o.hi for o in out], -1))
-
-    return predict
+#: Smoothing rounds per ping by default (see the benchmark: the widths it buys, its time).
+DEFAULT_SWEEPS = 1
+#: Passes of the ray-cast contractor per ping contraction.
+DEFAULT_PASSES = 3
 
 
-def observer_of(ctc: CtcRayCast, passes: int = 3):
-    """Contract state boxes ``(..., 4)`` with one ping ``(alpha, d)``: the ray-cast contractor
-    on ``(x, y, theta + alpha, d)``, then ``theta`` from the contracted beam direction."""
-    fix = Fixpoint(ctc, max_iter=passes) if passes > 1 else ctc
-
-    def observe(x: Interval, ping: tuple[float, Interval]) -> Interval:
-        alpha, d = ping
-        beta = x[..., 2] + alpha
-        d = Interval._new(np.broadcast_to(d.lo, beta.shape), np.broadcast_to(d.hi, beta.shape))
-        box = Interval._new(np.stack([x.lo[..., 0], x.lo[..., 1], beta.lo, d.lo], -1),
-                            np.stack([x.hi[..., 0], x.hi[..., 1], beta.hi, d.hi], -1))
-        c = fix(box)
-        th = x[..., 2] & (c[..., 2] - alpha)
-        out = Interval._new(np.stack([c.lo[..., 0], c.lo[..., 1], th.lo, x.lo[..., 3]], -1),
-                            np.stack([c.hi[..., 0], c.hi[..., 1], th.hi, x.hi[..., 3]], -1))
-        bad = np.isnan(out.lo).any(-1, keepdims=True)
-        return Interval._new(np.where(bad, np.nan, out.lo), np.where(bad, np.nan, out.hi))
-
-    return observe
+def _dt(dt: float) -> tuple[float, float]:
+    return float(np.nextafter(dt, -np.inf)), float(np.nextafter(dt, np.inf))
 
 
 def restart_box(data: PoolData) -> Interval:
@@ -80,15 +51,93 @@ def restart_box(data: PoolData) -> Interval:
                     [seg[:, 0].max(), seg[:, 1].max(), np.inf, vmax])
 
 
-def pool_observer(data: PoolData, q: int = 8, m: int = 80, passes: int = 3) -> RobustObserver:
-    """The observer for ``data`` (a mission or a batch of simulated missions), ready for
-    ``update(u_k, (alpha_k, d_k))``: ``u_k`` the input box since the previous ping."""
-    x0 = data.x0
-    if data.n_missions is not None:
-        x0 = Interval._new(np.broadcast_to(x0.lo, (data.n_missions, 4)).copy(),
-                           np.broadcast_to(x0.hi, (data.n_missions, 4)).copy())
-    return RobustObserver(predictor(data.dt), observer_of(CtcRayCast(data.map), passes), x0,
-                          m=m, q=q, restart=restart_box(data))
+def _eps(paving: float | None) -> float:
+    if paving is None:
+        return 0.0
+    if not np.isfinite(paving) or paving <= 0:
+        raise ValueError(f"the paving precision must be a positive number of metres, got "
+                         f"{paving!r}")
+    return float(paving)
+
+
+def _check(q: int, m: int, sweeps: int, passes: int) -> np.ndarray:
+    if m < 1 or q < 0 or sweeps < 0 or passes < 1:
+        raise ValueError(f"need m >= 1, q >= 0, sweeps >= 0 and passes >= 1, got m={m}, "
+                         f"q={q}, sweeps={sweeps}, passes={passes}")
+    return np.array([m, q, sweeps, passes, 0], dtype=np.int64)
+
+
+class PoolObserver:
+    """The online robust observer of one pool mission: ``update(u, alpha, d)`` per ping.
+
+    Parameters
+    ----------
+    data : PoolData
+        What the observer knows before the first ping: the map, ``dt``, ``x0`` and the
+        bounds of the restart box (its pings and inputs are not read).
+    q, m : int
+        Outliers allowed among the last ``m`` pings.
+    sweeps : int
+        Smoothing rounds inside the window per ping (0: the plain recursive observer).
+    passes : int
+        Passes of the ray-cast contractor per contraction.
+    carry : bool
+        True: the recursive observer (its previous set carried forward); False: the pure
+        window observer (each set from the open-loop prior and the window's pings alone).
+    paving : float, optional
+        Pave ``(x, y)`` of each set into cells of this side and keep the hull of the cells
+        that survive (tighter, slower); None: boxes only.
+
+    Examples
+    --------
+    >>> from boundest.scenarios.pool_data import load_pool
+    >>> data = load_pool()
+    >>> obs = PoolObserver(data, q=8, m=80)
+    >>> box, rejected, empty = obs.update(None, float(data.alpha[0]), data.ranges[0])
+    >>> bool(data.x0.contains(box.mid()).all()), rejected, empty
+    (True, 0, False)
+    """
+
+    def __init__(self, data: PoolData, q: int = 8, m: int = 80, sweeps: int = DEFAULT_SWEEPS,
+                 passes: int = DEFAULT_PASSES, carry: bool = True,
+                 paving: float | None = None) -> None:
+        self.par = _check(q, m, sweeps, passes)
+        self.eps = _eps(paving)
+        self.par[po.CARRY] = int(bool(carry))
+        self.q, self.m = int(q), int(m)
+        self.tapes = pack_tapes(data.map)
+        self.x0 = data.x0
+        self.restart = restart_box(data)
+        self.h = _dt(data.dt)
+        self.ring = po.make_ring(self.m)
+        self.work = po.make_work(self.m, self.tapes.lo0.size)
+        self.cells = np.empty((po.MAX_SIDE**2 if self.eps else 0, 4)), np.empty(
+            (po.MAX_SIDE**2 if self.eps else 0, 4))
+        self.k = 0
+
+    def update(self, u: Interval | None, alpha: float, d: Interval
+               ) -> tuple[Interval, int, bool]:
+        """Advance to the next ping: ``u`` the input box ``(u1, u2)`` applied since the
+        previous ping (None at the first), ``alpha`` the beam angle relative to the robot,
+        ``d`` the range interval. Returns ``(X_k, rejected, empty)``: the state box, the pings
+        of the window inconsistent with it, and whether the set came out empty (then the
+        observer restarted from the window alone)."""
+        if u is None:
+            if self.k:
+                raise ValueError(f"update {self.k} needs the input box applied since the "
+                                 "previous ping")
+            ul = uh = np.zeros(2)
+        else:
+            ul = np.ascontiguousarray(u.lo, dtype=np.float64).reshape(2)
+            uh = np.ascontiguousarray(u.hi, dtype=np.float64).reshape(2)
+        xl, xh = np.empty(4), np.empty(4)
+        rej, empty, _ = po.observer_update(self.k, ul, uh, float(alpha), float(d.lo),
+                                           float(d.hi), self.par, self.eps, self.x0.lo,
+                                           self.x0.hi, self.restart.lo, self.restart.hi,
+                                           self.h[0], self.h[1], self.tapes, self.ring, xl, xh,
+                                           self.work, self.cells[0], self.cells[1])
+        self.k += 1
+        return Interval._new(xl, xh), int(rej), bool(empty)
 
 
 @dataclass(repr=False)
@@ -103,11 +152,17 @@ class PoolResult:
         Pings of the window inconsistent with ``X_k``.
     empty : ndarray of bool
         Steps where the set came out empty (more than q outliers in the window): the observer
-        restarted there.
+        restarted there from the window alone.
     window_probability : ndarray, shape (n,)
         ``P(at most q outliers among the pings of the window at k)``: the probability that one
-        window is fine; the recursive set at ``k`` needs every window since the last restart to
-        be (module :mod:`boundest.estimation.robust`).
+        window is fine, the guarantee of the pure window observer; the recursive set at ``k``
+        needs every window since the last restart to be (:mod:`.pool_observer`).
+    cells : ndarray of int, shape (n,) or (M, n)
+        Cells of the ``(x, y)`` paving kept at each step (0 without a paving).
+    paving : Interval, shape (n, C, 4) or (M, n, C, 4), optional
+        The first ``C`` kept cells of each step (NaN rows beyond ``cells``).
+    eps : float, optional
+        The paving's precision.
     """
 
     boxes: Interval
@@ -117,6 +172,9 @@ class PoolResult:
     q: int
     m: int
     time_s: float
+    cells: NDArray[np.intp]
+    paving: Interval | None = None
+    eps: float | None = None
 
     def centre(self) -> NDArray[np.float64]:
         """The Chebyshev centre of each box (its midpoint; NaN where empty)."""
@@ -132,20 +190,45 @@ class PoolResult:
                 f"{int(np.count_nonzero(self.empty))}, time_s={self.time_s:.3g})")
 
 
-def solve_pool(data: PoolData, q: int = 8, m: int = 80, passes: int = 3) -> PoolResult:
-    """Run the observer over the whole mission (or batch of missions) offline."""
+def solve_pool(data: PoolData, q: int = 8, m: int = 80, sweeps: int = DEFAULT_SWEEPS,
+               passes: int = DEFAULT_PASSES, carry: bool = True, paving: float | None = None,
+               keep_cells: int = 256) -> PoolResult:
+    """Run the observer over the whole mission (or every mission of a batch) offline: the
+    same updates as :class:`PoolObserver` (parameters there), all in one compiled call.
+    With ``paving``, the first ``keep_cells`` kept cells of each step are returned."""
+    par = _check(q, m, sweeps, passes)
+    eps = _eps(paving)
+    n_cells = keep_cells if eps else 0
+    par[po.CARRY] = int(bool(carry))
     start = time.perf_counter()
-    obs = pool_observer(data, q, m, passes)
-    boxes, rejected, empty = [], [], []
-    for k in range(data.n):  # sequential by nature: each step needs the previous set
-        u = data.inputs[..., k - 1, :] if k else None
-        step = obs.update(u, (float(data.alpha[k]), data.ranges[..., k]))
-        boxes.append(step.box)
-        rejected.append(step.rejected)
-        empty.append(step.empty)
-    axis = 0 if data.n_missions is None else 1
-    b = Interval._new(np.stack([x.lo for x in boxes], axis), np.stack([x.hi for x in boxes], axis))
-    probs = np.array([window_probability(min(k + 1, m), q, data.p_outlier)
-                      for k in range(data.n)])
-    return PoolResult(b, np.stack(rejected, axis), np.stack(empty, axis), probs, q, m,
-                      time.perf_counter() - start)
+    tapes = pack_tapes(data.map)
+    restart = restart_box(data)
+    batch = data.n_missions is not None
+    n_m = data.n_missions if batch else 1
+    ul = np.ascontiguousarray(np.broadcast_to(data.inputs.lo, (n_m, data.n, 2)))
+    uh = np.ascontiguousarray(np.broadcast_to(data.inputs.hi, (n_m, data.n, 2)))
+    dl = np.ascontiguousarray(data.ranges.lo, dtype=np.float64).reshape(n_m, data.n)
+    dh = np.ascontiguousarray(data.ranges.hi, dtype=np.float64).reshape(n_m, data.n)
+    xl, xh = np.empty((n_m, data.n, 4)), np.empty((n_m, data.n, 4))
+    rejected = np.zeros((n_m, data.n), dtype=np.int64)
+    empty = np.zeros((n_m, data.n), dtype=np.bool_)
+    cells = np.zeros((n_m, data.n), dtype=np.int64)
+    cl = np.full((n_m, data.n, n_cells, 4), np.nan)
+    ch = np.full((n_m, data.n, n_cells, 4), np.nan)
+    h = _dt(data.dt)
+    alpha = np.ascontiguousarray(data.alpha, dtype=np.float64)
+    ring, work = po.make_ring(m), po.make_work(m, tapes.lo0.size)
+    args = (par, eps, data.x0.lo, data.x0.hi, restart.lo, restart.hi, h[0], h[1], tapes, ring,
+            work)
+    # no mission: compiles (first run) or loads the kernel, outside the timed part
+    po.run_missions(ul[:0], uh[:0], alpha, dl[:0], dh[:0], *args, xl[:0], xh[:0], rejected[:0],
+                    empty[:0], cells[:0], cl[:0], ch[:0])
+    start = time.perf_counter()
+    po.run_missions(ul, uh, alpha, dl, dh, *args, xl, xh, rejected, empty, cells, cl, ch)
+    probs = np.array([binomial_bound(min(k + 1, m), q, data.p_outlier) for k in range(data.n)])
+    if not batch:
+        xl, xh, rejected, empty, cells, cl, ch = (xl[0], xh[0], rejected[0], empty[0],
+                                                  cells[0], cl[0], ch[0])
+    elapsed = time.perf_counter() - start
+    return PoolResult(Interval._new(xl, xh), rejected, empty, probs, q, m, elapsed, cells,
+                      Interval._new(cl, ch) if eps else None, eps or None)
