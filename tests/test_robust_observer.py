@@ -107,7 +107,7 @@ def test_paving_keeps_the_truth_and_tightens():
                     data.ranges[:, :160], data.x0, data.map, data.p_outlier)
     states, outlier = truth.states[:, :160], truth.outlier[:, :160]
     box = solve_pool(data, q=8, m=80, sweeps=0)
-    paved = solve_pool(data, q=8, m=80, sweeps=0, paving=0.3)
+    paved = solve_pool(data, q=8, m=80, sweeps=0, paving=0.5, paving_heading=0.1)
     assert paved.cells.min() >= 1 and paved.paving is not None
     ok = _guaranteed(outlier, paved.empty, 80, 8)
     inside = ((paved.boxes.lo <= states) & (states <= paved.boxes.hi)).all(-1)
@@ -118,8 +118,9 @@ def test_paving_keeps_the_truth_and_tightens():
     assert (cells.lo[n][:, :2] >= paved.boxes.lo[..., None, :2].repeat(cells.shape[-2], -2)[n]
             ).all()
     assert paved.widths()[..., :2].mean() < box.widths()[..., :2].mean()
-    with pytest.raises(ValueError, match="paving"):
-        solve_pool(data, paving=0.0)
+    for bad in ({"paving": 0.0}, {"paving_heading": -1.0}, {"paving": float("nan")}):
+        with pytest.raises(ValueError, match="paving"):
+            solve_pool(data, **bad)
 
 
 def test_embedded_mission():

@@ -71,10 +71,11 @@ def run(args: argparse.Namespace) -> int:
           f"outlier probability {data.p_outlier:g} per ping (data: {data.source}; read in "
           f"{read_s:.2f} s)")
     kw = {"q": args.q, "m": args.m, "sweeps": args.sweeps, "carry": not args.window_only,
-          "paving": args.paving}
+          "paving": args.paving, "paving_heading": args.paving_heading}
+    paved = args.paving is not None or args.paving_heading is not None
     what = ("pure window observer" if args.window_only else "recursive observer") + (
         f", {args.sweeps} smoothing round(s) per ping" if args.sweeps else ", no smoothing") + (
-        f", (x, y) paved at {args.paving:g} m" if args.paving else "")
+        f", paving with {_sides((args.paving, args.paving_heading))}" if paved else "")
     print(f"{what} ({'online, one update per ping' if args.online else 'offline'}); the "
           "first run compiles its kernels (about a minute, once)", flush=True)
     res, per_update = (_online(data, kw) if args.online else (solve_pool(data, **kw), None))
@@ -99,7 +100,7 @@ def run(args: argparse.Namespace) -> int:
              f" ({len(per_update)} online updates: median {np.median(per_update) * 1e3:.2f} ms,"
              f" max {np.max(per_update) * 1e3:.2f} ms)"))
     if res.eps:
-        print(f"paving: {res.cells.mean():.1f} cells of side <= {res.eps:g} m kept per step on "
+        print(f"paving ({_sides(res.eps)}): {res.cells.mean():.1f} cells kept per step on "
               "average")
     rows = table_rows(data, res)
     table = format_table(rows, args.q)
@@ -174,12 +175,19 @@ def to_json(data, res, args, p_full: float, rows: list[dict], per_update=None) -
     return {"scenario": "pool", "data": data.source, "samples": data.n, "t0": data.t0,
             "dt": data.dt, "p_outlier": data.p_outlier, "q": args.q, "m": args.m,
             "observer": "window" if args.window_only else "recursive",
-            "sweeps": args.sweeps, "paving": args.paving, "online": online,
+            "sweeps": args.sweeps, "paving": args.paving,
+            "paving_heading": args.paving_heading, "online": online,
             "window_probability": p_full,
             "guarantee": GUARANTEE[not args.window_only].format(m=args.m, q=args.q),
             "width_mean": w, "width_mean_steps": nw,
             "empty_steps": np.flatnonzero(res.empty), "max_rejected": int(res.rejected.max()),
             "time_s": res.time_s, "table": rows, "steps": steps}
+
+
+def _sides(eps) -> str:
+    xy, th = eps
+    return ", ".join(([f"(x, y) cells of {xy:g} m"] if xy else [])
+                     + ([f"heading slices of {th:g} rad"] if th else []))
 
 
 def _online(data, kw: dict):
@@ -220,7 +228,10 @@ def register(runs: argparse._SubParsersAction) -> None:
                    "recursive box observer, about 15x faster and wider)")
     p.add_argument("--paving", type=float, metavar="EPS",
                    help="pave (x, y) of each set into cells of side EPS metres and keep the "
-                   "hull of the consistent cells (tighter; about 10x slower at 0.25)")
+                   "hull of the cells whose window is consistent (tighter, slower)")
+    p.add_argument("--paving-heading", type=float, metavar="RAD",
+                   help="also cut the heading into slices of RAD radians (what pays most: "
+                   "e.g. 0.05)")
     p.add_argument("--window-only", action="store_true",
                    help="the pure window observer: each set from the open-loop prior and the "
                    "window's pings alone (its per-step guarantee is the binomial bound)")

@@ -51,15 +51,16 @@ def _check_q(q: int) -> int:
 
 
 @nb.njit(cache=True, error_model="numpy")
-def first_covered(lo, hi, n, k, lows, highs):
-    """The smallest real covered by at least ``k >= 1`` of the intervals ``[lo[i], hi[i]]``,
-    ``i < n`` (NaN bounds: empty, covering nothing); NaN when no real is. ``lows``/``highs``:
-    scratch of ``n`` floats.
+def covered_hull(lo, hi, n, k, lows, highs):
+    """``(a, b)``: the smallest and the largest real covered by at least ``k >= 1`` of the
+    intervals ``[lo[i], hi[i]]``, ``i < n`` (NaN bounds: empty, covering nothing); NaNs when
+    no real is. ``lows``/``highs``: scratch of ``n`` floats.
 
     Sweep: the bounds sorted, lower bounds before upper bounds at equal coordinates (the
     intervals are closed), a running count +1 at a lower bound and -1 at an upper bound. The
     count only grows at lower bounds, so the first position where it reaches ``k`` is a lower
-    bound ``c``, covered by at least ``k`` intervals, and every real below ``c`` by fewer.
+    bound ``a``, covered by at least ``k`` intervals, and every real below ``a`` by fewer. The
+    same sweep from the top, over the same sorted bounds, gives ``b``.
     """
     m = 0
     for i in range(n):
@@ -68,9 +69,10 @@ def first_covered(lo, hi, n, k, lows, highs):
             highs[m] = hi[i]
             m += 1
     if m < k:
-        return np.nan
+        return np.nan, np.nan
     lows[:m].sort()
     highs[:m].sort()
+    a = np.nan
     count, j = 0, 0
     for i in range(m):
         while j < m and highs[j] < lows[i]:  # upper bounds strictly before this lower bound
@@ -78,26 +80,37 @@ def first_covered(lo, hi, n, k, lows, highs):
             j += 1
         count += 1
         if count >= k:
-            return lows[i]
-    return np.nan
+            a = lows[i]
+            break
+    b = np.nan
+    count, j = 0, m - 1
+    for i in range(m - 1, -1, -1):
+        while j >= 0 and lows[j] > highs[i]:  # lower bounds strictly after this upper bound
+            count -= 1
+            j -= 1
+        count += 1
+        if count >= k:
+            b = highs[i]
+            break
+    return a, b
 
 
 @nb.njit(cache=True, error_model="numpy")
-def _first_covered_rows(lo, hi, k):
+def _covered_rows(lo, hi, k, out_lo, out_hi):
     n = lo.shape[1]
-    out = np.empty(lo.shape[0])
     lows, highs = np.empty(n), np.empty(n)
     for r in range(lo.shape[0]):
-        out[r] = first_covered(lo[r], hi[r], n, k, lows, highs)
-    return out
+        out_lo[r], out_hi[r] = covered_hull(lo[r], hi[r], n, k, lows, highs)
 
 
-def _first_covered(lo: NDArray, hi: NDArray, k: int) -> NDArray:
-    """:func:`first_covered` along the last axis of ``lo``/``hi`` (a batch on the others)."""
+def _covered(lo: NDArray, hi: NDArray, k: int) -> tuple[NDArray, NDArray]:
+    """:func:`covered_hull` along the last axis of ``lo``/``hi`` (a batch on the others)."""
     n = lo.shape[-1]
-    rows = _first_covered_rows(np.ascontiguousarray(lo, dtype=np.float64).reshape(-1, n),
-                               np.ascontiguousarray(hi, dtype=np.float64).reshape(-1, n), k)
-    return rows.reshape(lo.shape[:-1])
+    rows = int(np.prod(lo.shape[:-1], dtype=np.int64))
+    out_lo, out_hi = np.empty(rows), np.empty(rows)
+    _covered_rows(np.ascontiguousarray(lo, dtype=np.float64).reshape(-1, n),
+                  np.ascontiguousarray(hi, dtype=np.float64).reshape(-1, n), k, out_lo, out_hi)
+    return out_lo.reshape(lo.shape[:-1]), out_hi.reshape(lo.shape[:-1])
 
 
 def qinter(intervals: Interval, q: int, axis: int = 0) -> Interval:
@@ -149,8 +162,7 @@ def qinter(intervals: Interval, q: int, axis: int = 0) -> Interval:
     k = n - q
     if k <= 0:
         return Interval.entire(lo.shape[:-1])
-    lower = _first_covered(lo, hi, k)
-    upper = -_first_covered(-hi, -lo, k)  # the largest covered real, by symmetry
+    lower, upper = _covered(lo, hi, k)
     return Interval._new(lower, upper)
 
 

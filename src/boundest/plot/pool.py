@@ -118,7 +118,7 @@ def plot_pool_snapshot(data: PoolData, res: PoolResult, k: int,
         cells = res.paving[k, : min(int(res.cells[k]), res.paving.shape[-2])]
         _rects(ax, cells.lo[:, :2], cells.hi[:, :2], facecolor="none", edgecolor=CELL, lw=0.6)
         ax.plot([], [], "s", mfc="none", mec=CELL,
-                label=f"paving cells kept ({int(res.cells[k])}, side <= {res.eps:g} m)")
+                label=f"paving cells kept ({int(res.cells[k])})")
     return ax
 
 

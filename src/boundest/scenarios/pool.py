@@ -31,7 +31,7 @@ __all__ = ["DEFAULT_PASSES", "DEFAULT_SWEEPS", "PoolObserver", "PoolResult", "re
 #: Smoothing rounds per ping by default (see the benchmark: the widths it buys, its time).
 DEFAULT_SWEEPS = 1
 #: Passes of the ray-cast contractor per ping contraction.
-DEFAULT_PASSES = 3
+DEFAULT_PASSES = 1
 
 
 def _dt(dt: float) -> tuple[float, float]:
@@ -51,13 +51,13 @@ def restart_box(data: PoolData) -> Interval:
                     [seg[:, 0].max(), seg[:, 1].max(), np.inf, vmax])
 
 
-def _eps(paving: float | None) -> float:
-    if paving is None:
-        return 0.0
-    if not np.isfinite(paving) or paving <= 0:
-        raise ValueError(f"the paving precision must be a positive number of metres, got "
-                         f"{paving!r}")
-    return float(paving)
+def _eps(paving: float | None, heading: float | None) -> np.ndarray:
+    """The sides of the paving's cells in ``(x, y, theta)`` (``inf``: not cut)."""
+    for name, v in (("paving", paving), ("paving_heading", heading)):
+        if v is not None and not (np.isfinite(v) and v > 0):
+            raise ValueError(f"the {name} precision must be a positive number, got {v!r}")
+    xy = np.inf if paving is None else float(paving)
+    return np.array([xy, xy, np.inf if heading is None else float(heading)])
 
 
 def _check(q: int, m: int, sweeps: int, passes: int) -> np.ndarray:
@@ -85,8 +85,11 @@ class PoolObserver:
         True: the recursive observer (its previous set carried forward); False: the pure
         window observer (each set from the open-loop prior and the window's pings alone).
     paving : float, optional
-        Pave ``(x, y)`` of each set into cells of this side and keep the hull of the cells
-        that survive (tighter, slower); None: boxes only.
+        Pave ``(x, y)`` of each set into cells of this side [m] and keep the hull of the
+        cells whose window is consistent (tighter, slower); None: boxes only.
+    paving_heading : float, optional
+        Also cut ``theta`` into slices of this width [rad] (what pays most: on a thin heading
+        slice the pings pin the position).
 
     Examples
     --------
@@ -100,9 +103,9 @@ class PoolObserver:
 
     def __init__(self, data: PoolData, q: int = 8, m: int = 80, sweeps: int = DEFAULT_SWEEPS,
                  passes: int = DEFAULT_PASSES, carry: bool = True,
-                 paving: float | None = None) -> None:
+                 paving: float | None = None, paving_heading: float | None = None) -> None:
         self.par = _check(q, m, sweeps, passes)
-        self.eps = _eps(paving)
+        self.eps = _eps(paving, paving_heading)
         self.par[po.CARRY] = int(bool(carry))
         self.q, self.m = int(q), int(m)
         self.tapes = pack_tapes(data.map)
@@ -111,8 +114,7 @@ class PoolObserver:
         self.h = _dt(data.dt)
         self.ring = po.make_ring(self.m)
         self.work = po.make_work(self.m, self.tapes.lo0.size)
-        self.cells = np.empty((po.MAX_SIDE**2 if self.eps else 0, 4)), np.empty(
-            (po.MAX_SIDE**2 if self.eps else 0, 4))
+        self.cells = np.empty((0, 4)), np.empty((0, 4))
         self.k = 0
 
     def update(self, u: Interval | None, alpha: float, d: Interval
@@ -161,8 +163,8 @@ class PoolResult:
         Cells of the ``(x, y)`` paving kept at each step (0 without a paving).
     paving : Interval, shape (n, C, 4) or (M, n, C, 4), optional
         The first ``C`` kept cells of each step (NaN rows beyond ``cells``).
-    eps : float, optional
-        The paving's precision.
+    eps : (float or None, float or None), optional
+        The paving's cell sides in ``(x, y)`` [m] and ``theta`` [rad] (None: not cut).
     """
 
     boxes: Interval
@@ -174,7 +176,7 @@ class PoolResult:
     time_s: float
     cells: NDArray[np.intp]
     paving: Interval | None = None
-    eps: float | None = None
+    eps: tuple[float | None, float | None] | None = None
 
     def centre(self) -> NDArray[np.float64]:
         """The Chebyshev centre of each box (its midpoint; NaN where empty)."""
@@ -192,13 +194,14 @@ class PoolResult:
 
 def solve_pool(data: PoolData, q: int = 8, m: int = 80, sweeps: int = DEFAULT_SWEEPS,
                passes: int = DEFAULT_PASSES, carry: bool = True, paving: float | None = None,
-               keep_cells: int = 256) -> PoolResult:
+               paving_heading: float | None = None, keep_cells: int = 256) -> PoolResult:
     """Run the observer over the whole mission (or every mission of a batch) offline: the
     same updates as :class:`PoolObserver` (parameters there), all in one compiled call.
     With ``paving``, the first ``keep_cells`` kept cells of each step are returned."""
     par = _check(q, m, sweeps, passes)
-    eps = _eps(paving)
-    n_cells = keep_cells if eps else 0
+    eps = _eps(paving, paving_heading)
+    paved = bool(np.isfinite(eps).any())
+    n_cells = keep_cells if paved else 0
     par[po.CARRY] = int(bool(carry))
     start = time.perf_counter()
     tapes = pack_tapes(data.map)
@@ -231,4 +234,5 @@ def solve_pool(data: PoolData, q: int = 8, m: int = 80, sweeps: int = DEFAULT_SW
                                                   cells[0], cl[0], ch[0])
     elapsed = time.perf_counter() - start
     return PoolResult(Interval._new(xl, xh), rejected, empty, probs, q, m, elapsed, cells,
-                      Interval._new(cl, ch) if eps else None, eps or None)
+                      Interval._new(cl, ch) if paved else None,
+                      (paving, paving_heading) if paved else None)

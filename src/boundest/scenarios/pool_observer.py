@@ -45,7 +45,7 @@ import numpy as np
 from ..ctc.raycast import raycast_box
 from ..interval import arith as ar
 from ..interval import trig as tr
-from ..interval.relaxed import first_covered as _first_covered
+from ..interval.relaxed import covered_hull
 
 __all__ = ["observer_update", "run_missions"]
 
@@ -200,10 +200,7 @@ def _qinter(FL, FH, first, k, m, q, xl, xh, lows, highs, col_lo, col_hi):
                 js = int(kept[i]) % m
                 col_lo[i] = FL[js, c]
                 col_hi[i] = FH[js, c]
-            lo = _first_covered(col_lo, col_hi, n, need, lows, highs)
-            for i in range(n):
-                col_lo[i], col_hi[i] = -col_hi[i], -col_lo[i]
-            hi = -_first_covered(col_lo, col_hi, n, need, lows, highs)
+            lo, hi = covered_hull(col_lo, col_hi, n, need, lows, highs)
             xl[c] = max(xl[c], lo) if lo == lo else lo
             xh[c] = min(xh[c], hi) if hi == hi else hi
             if not xl[c] <= xh[c]:
@@ -295,13 +292,15 @@ def _solve_window(SL, SH, UL, UH, AL, DL, DH, FL, FH, first, k, par, hl, hh, tp,
 @_njit
 def _pave(xl, xh, FL, FH, SL, SH, UL, UH, AL, DL, DH, first, k, par, eps, hl, hh, tp, work,
           cell_l, cell_h):
-    """``x ∩=`` the hull of the kept cells of a regular paving of its ``(x, y)`` into cells of
-    side at most ``eps`` (at most ``MAX_SIDE`` per axis); returns the number of cells kept (0:
-    the set is empty), the first ``cell_l.shape[0]`` of them written to ``cell_l``/``cell_h``.
+    """``x ∩=`` the hull of the kept cells of a regular paving of its ``(x, y, theta)`` into
+    cells of sides at most ``eps`` (3 values, ``inf``: that component is not cut; at most
+    ``MAX_SIDE`` cuts per component); returns the number of cells kept (0: the set is empty),
+    the first ``cell_l.shape[0]`` of them written to ``cell_l``/``cell_h``.
 
-    Each cell (with the ``theta``, ``v`` of ``x``) replaces ``S_k`` in a copy of the window,
+    Each cell (with the ``v`` of ``x``) replaces ``S_k`` in a copy of the window,
     which is solved again (:func:`_smooth`, :func:`_solve_window`): on a small cell the pings
-    contract the heading, which the whole box could not. A cell whose window comes out empty
+    contract the heading, and on a thin heading slice the position, which the whole box
+    could not. A cell whose window comes out empty
     holds no state consistent with all but ``q`` pings. The window's states become the hull
     of the kept cells' windows.
     """
@@ -309,19 +308,20 @@ def _pave(xl, xh, FL, FH, SL, SH, UL, UH, AL, DL, DH, first, k, par, eps, hl, hh
     tmp_l, tmp_h, buf = work[1], work[2], work[3]
     SL2, SH2, FL2, FH2 = SL.copy(), SH.copy(), FL.copy(), FH.copy()
     WL, WH = np.full(SL.shape, np.inf), np.full(SL.shape, -np.inf)
-    n_side = np.empty(2, dtype=np.int64)
-    for c in range(2):
-        n_side[c] = min(MAX_SIDE, max(1, int(np.ceil((xh[c] - xl[c]) / eps))))
+    n_side = np.empty(3, dtype=np.int64)
+    for c in range(3):
+        cuts = (xh[c] - xl[c]) / eps[c]  # inf: an unbounded side; 0: no paving of c
+        n_side[c] = min(MAX_SIDE, max(1, int(np.ceil(cuts)))) if cuts < np.inf else 1
     bl, bh = np.empty(4), np.empty(4)
     kept = 0
-    for cell in range(n_side[0] * n_side[1]):
-        idx = (cell % n_side[0], cell // n_side[0])
-        for c in range(2):
+    for cell in range(n_side[0] * n_side[1] * n_side[2]):
+        idx = (cell % n_side[0], (cell // n_side[0]) % n_side[1], cell // (n_side[0] * n_side[1]))
+        for c in range(3):
             step = (xh[c] - xl[c]) / n_side[c]
             bl[c] = xl[c] + idx[c] * step if idx[c] > 0 else xl[c]
             bh[c] = xl[c] + (idx[c] + 1) * step if idx[c] < n_side[c] - 1 else xh[c]
-        bl[2:] = xl[2:]
-        bh[2:] = xh[2:]
+        bl[3:] = xl[3:]
+        bh[3:] = xh[3:]
         SL2[:] = SL
         SH2[:] = SH
         SL2[k % m] = bl
@@ -355,8 +355,9 @@ def observer_update(k, ul, uh, alpha, dl, dh, par, eps, x0l, x0h, rl, rh, hl, hh
     ``u``: the input box applied since ping ``k - 1`` (ignored at ``k = 0``); ``par``: ``[m, q,
     sweeps, passes, carry]``; ``x0``, ``r``: the initial and the restart box (pool and speed
     bound); ``h`` = dt as an interval; ``ring = (SL, SH, PL, PH, FL, FH, UL, UH, AL, DL, DH)``
-    (``m`` rows each); ``x``: the result ``X_k``; ``eps > 0``: pave ``(x, y)`` at that
-    precision (:func:`_pave`), the kept cells into ``cell_l``/``cell_h``. Returns
+    (``m`` rows each); ``x``: the result ``X_k``; ``eps``: the sides of the cells of a paving
+    of ``(x, y, theta)`` (:func:`_pave`; all ``inf``: none), the kept cells into
+    ``cell_l``/``cell_h``. Returns
     ``(rejected, empty, cells)``: the pings of the window whose ``F_j`` misses ``X_k``, whether
     the set came out empty (then the observer restarted), and the cells kept (0 without
     paving).
@@ -410,7 +411,7 @@ def observer_update(k, ul, uh, alpha, dl, dh, par, eps, x0l, x0h, rl, rh, hl, hh
         ok = _solve_window(SL, SH, UL, UH, AL, DL, DH, FL, FH, first, k, par, hl, hh, tp, xl,
                            xh, work)
     cells = 0
-    if ok and eps > 0.0:
+    if ok and eps.min() < np.inf:
         cells = _pave(xl, xh, FL, FH, SL, SH, UL, UH, AL, DL, DH, first, k, par, eps, hl, hh, tp,
                       work, cell_l, cell_h)
         ok = cells > 0
