@@ -193,8 +193,7 @@ def _sides(eps) -> str:
 def _online(data, kw: dict):
     """The mission through :class:`PoolObserver`, one update per ping, each timed."""
     from ..interval import Interval
-    from ..scenarios.pool import PoolObserver, PoolResult
-    from ..scenarios.pool_data import binomial_bound
+    from ..scenarios.pool import PoolObserver, PoolResult, window_probabilities
 
     obs = PoolObserver(data, **kw)
     boxes, rejected, empty, times = [], [], [], []
@@ -206,8 +205,7 @@ def _online(data, kw: dict):
         boxes.append(box)
         rejected.append(rej)
         empty.append(emp)
-    probs = np.array([binomial_bound(min(k + 1, kw["m"]), kw["q"], data.p_outlier)
-                      for k in range(data.n)])
+    probs = window_probabilities(data.n, kw["m"], kw["q"], data.p_outlier)
     res = PoolResult(Interval._new(np.stack([b.lo for b in boxes]),
                                    np.stack([b.hi for b in boxes])),
                      np.array(rejected), np.array(empty), probs, kw["q"], kw["m"],

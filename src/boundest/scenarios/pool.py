@@ -26,7 +26,7 @@ from . import pool_observer as po
 from .pool_data import PoolData, binomial_bound
 
 __all__ = ["DEFAULT_PASSES", "DEFAULT_SWEEPS", "PoolObserver", "PoolResult", "restart_box",
-           "solve_pool"]
+           "solve_pool", "window_probabilities"]
 
 #: Smoothing rounds per ping by default (see the benchmark: the widths it buys, its time).
 DEFAULT_SWEEPS = 1
@@ -49,6 +49,12 @@ def restart_box(data: PoolData) -> Interval:
     vmax = float(np.nextafter(vmax, np.inf))
     return Interval([seg[:, 0].min(), seg[:, 1].min(), -np.inf, -vmax],
                     [seg[:, 0].max(), seg[:, 1].max(), np.inf, vmax])
+
+
+def window_probabilities(n: int, m: int, q: int, p: float) -> NDArray[np.float64]:
+    """``P(at most q outliers among the min(k + 1, m) pings of the window at k)``, k < n."""
+    bound = {w: binomial_bound(w, q, p) for w in range(1, min(n, m) + 1)}
+    return np.array([bound[min(k + 1, m)] for k in range(n)])
 
 
 def _eps(paving: float | None, heading: float | None) -> np.ndarray:
@@ -228,11 +234,11 @@ def solve_pool(data: PoolData, q: int = 8, m: int = 80, sweeps: int = DEFAULT_SW
                     empty[:0], cells[:0], cl[:0], ch[:0])
     start = time.perf_counter()
     po.run_missions(ul, uh, alpha, dl, dh, *args, xl, xh, rejected, empty, cells, cl, ch)
-    probs = np.array([binomial_bound(min(k + 1, m), q, data.p_outlier) for k in range(data.n)])
+    elapsed = time.perf_counter() - start
+    probs = window_probabilities(data.n, m, q, data.p_outlier)
     if not batch:
         xl, xh, rejected, empty, cells, cl, ch = (xl[0], xh[0], rejected[0], empty[0],
                                                   cells[0], cl[0], ch[0])
-    elapsed = time.perf_counter() - start
     return PoolResult(Interval._new(xl, xh), rejected, empty, probs, q, m, elapsed, cells,
                       Interval._new(cl, ch) if paved else None,
                       (paving, paving_heading) if paved else None)
