@@ -2,14 +2,17 @@
 observer on the embedded mission, its online update time, and a Monte Carlo check of what its
 set guarantees.
 
-- Embedded mission, in-process and warm: ``scenarios.pool.solve_pool`` at each ``--qs`` (median
-  of ``--repeat`` runs), mean widths, empty steps (restarts), the most pings rejected in a
-  window; the online ``update`` timed step by step (median and max).
-- Monte Carlo: ``--missions`` simulated missions (``scenarios.pool_sim.simulate_pool``, outliers
-  with p = 0.05), run as batches of ``--chunk`` missions through the same observer. Per step:
-  the empirical frequency with which the set contains the truth, with its 95 % Wilson score
-  interval, next to the per-window binomial bound
-  ``P(at most q outliers among the window's pings)`` and to the empirical frequency of the event
+- Embedded mission, in-process and warm: ``scenarios.pool.solve_pool`` in each mode (the
+  recursive box observer, smoothed inside the window, pavings of the heading and of (x, y)) at
+  q = 8 (median of ``--repeat`` runs for the fast modes), mean widths, empty steps (restarts),
+  the most pings rejected in a window; the smoothed mode at each ``--qs``; the online
+  ``PoolObserver.update`` timed step by step (median, p99, max).
+- Monte Carlo: simulated missions (``scenarios.pool_sim.simulate_pool``, outliers with
+  p = 0.05), in batches of ``--chunk``, for the recursive box observer (``--missions``), the
+  smoothed recursive and the pure window observers (``--missions-smoothed``). Per step: the
+  empirical frequency with which the set contains the truth, with its 95 % Wilson score
+  interval, next to the per-window binomial bound ``P(at most q outliers among the window's
+  pings)`` (the pure window observer's guarantee) and to the empirical frequency of the event
   the recursive set is conditioned on (every window so far held at most q outliers).
 
 Usage::
@@ -61,11 +64,15 @@ def main() -> int:
     ap.add_argument("--q", type=int, default=8, help="q of the Monte Carlo")
     ap.add_argument("--m", type=int, default=80)
     ap.add_argument("--repeat", type=int, default=3)
-    ap.add_argument("--missions", type=int, default=10_000)
+    ap.add_argument("--missions", type=int, default=10_000,
+                    help="Monte Carlo missions of the recursive box observer")
+    ap.add_argument("--missions-smoothed", type=int, default=300,
+                    help="Monte Carlo missions of the smoothed recursive and the pure window "
+                    "observers (about 1.4 s each)")
     ap.add_argument("--chunk", type=int, default=1000)
     args = ap.parse_args()
 
-    from boundest.scenarios.pool import pool_observer, solve_pool
+    from boundest.scenarios.pool import PoolObserver, solve_pool
     from boundest.scenarios.pool_data import load_pool
     from boundest.scenarios.pool_sim import simulate_pool
 
@@ -80,59 +87,105 @@ def main() -> int:
                            "codac_paving_eps_0.1": {"time_s": 291, "widths": [0.70, 0.61]},
                            "q6": "empty at the 4 steps whose window holds 7 outliers"}}
     data = load_pool()
-    solve_pool(data, q=args.q, m=args.m)  # load the kernels
-    emb = {}
-    for q in (int(s) for s in args.qs.split(",")):
-        times = []
-        for _ in range(args.repeat):
-            t0 = time.perf_counter()
-            res = solve_pool(data, q=q, m=args.m)
-            times.append(time.perf_counter() - t0)
+    modes = {"box": {"sweeps": 0}, "smoothed": {"sweeps": 1},
+             "heading_paving_0.1": {"sweeps": 0, "paving_heading": 0.1},
+             "heading_paving_0.05": {"sweeps": 0, "paving_heading": 0.05},
+             "xy_paving_0.25": {"sweeps": 0, "paving": 0.25}}
+    emb: dict[str, Any] = {}
+    for name, kw in modes.items():
+        solve_pool(data, q=args.q, m=args.m, **kw)  # compiles or loads the kernel
+        reps = args.repeat if name in ("box", "smoothed") else 1
+        runs = [solve_pool(data, q=args.q, m=args.m, **kw) for _ in range(reps)]
+        res = runs[-1]
         w = res.widths()
-        emb[str(q)] = {"median_s": statistics.median(times), "mean_width": w.mean(0).tolist(),
-                       "empty_steps": np.flatnonzero(res.empty).tolist(),
-                       "max_rejected": int(res.rejected.max()),
-                       "window_probability": res.window_probability[-1]}
-        log(f"embedded q={q}: {emb[str(q)]['median_s']:.2f} s, widths {w.mean(0)[:2]}")
-    obs = pool_observer(data, q=args.q, m=args.m)
-    steps = []
-    for k in range(data.n):
-        t0 = time.perf_counter()
-        obs.update(data.inputs[k - 1] if k else None, (float(data.alpha[k]), data.ranges[k]))
-        steps.append(time.perf_counter() - t0)
-    rec["embedded"] = emb
-    rec["online_update_s"] = {"median": statistics.median(steps), "max": max(steps)}
+        emb[name] = {"options": kw, "median_s": statistics.median(r.time_s for r in runs),
+                     "runs": reps, "mean_width": w.mean(0).tolist(),
+                     "empty_steps": np.flatnonzero(res.empty).tolist(),
+                     "max_rejected": int(res.rejected.max()),
+                     "cells_mean": float(res.cells.mean())}
+        log(f"embedded {name}: {emb[name]['median_s']:.3f} s, widths {w.mean(0)[:2]}")
+    rec["embedded_q8"] = emb
+    by_q = {}
+    for q in (int(s) for s in args.qs.split(",")):
+        res = solve_pool(data, q=q, m=args.m)
+        by_q[str(q)] = {"time_s": res.time_s, "mean_width": res.widths().mean(0).tolist(),
+                        "empty_steps": np.flatnonzero(res.empty).tolist(),
+                        "max_rejected": int(res.rejected.max()),
+                        "window_probability": res.window_probability[-1]}
+        log(f"embedded smoothed q={q}: {res.time_s:.2f} s, widths {res.widths().mean(0)[:2]}")
+    rec["embedded_smoothed_by_q"] = by_q
+    online = {}
+    for name in ("box", "smoothed"):
+        obs = PoolObserver(data, q=args.q, m=args.m, **modes[name])
+        steps = []
+        for k in range(data.n):
+            t0 = time.perf_counter()
+            obs.update(data.inputs[k - 1] if k else None, float(data.alpha[k]), data.ranges[k])
+            steps.append(time.perf_counter() - t0)
+        steps = steps[1:]  # the first update loads the kernel
+        online[name] = {"median_s": statistics.median(steps), "max_s": max(steps),
+                        "p99_s": float(np.quantile(steps, 0.99))}
+        log(f"online {name}: median {online[name]['median_s'] * 1e3:.3f} ms, max "
+            f"{online[name]['max_s'] * 1e3:.2f} ms")
+    rec["online_update"] = online
 
-    log(f"Monte Carlo: {args.missions} missions in chunks of {args.chunk} ...")
-    n = data.n
+    rec["monte_carlo"] = {
+        "recursive_box": monte_carlo(solve_pool, simulate_pool, args.missions, args.chunk,
+                                     args.q, args.m, {"sweeps": 0}, data.n),
+        "recursive_smoothed": monte_carlo(solve_pool, simulate_pool, args.missions_smoothed,
+                                          args.chunk, args.q, args.m, {"sweeps": 1}, data.n,
+                                          seed0=10**6),
+        "window_only": monte_carlo(solve_pool, simulate_pool, args.missions_smoothed,
+                                   args.chunk, args.q, args.m, {"carry": False}, data.n,
+                                   seed0=10**6),
+    }
+    rec["loadavg_end"] = os.getloadavg()
+    emit(rec, args.out)
+    return 0
+
+
+def monte_carlo(solve_pool, simulate_pool, missions: int, chunk: int, q: int, m: int,
+                kw: dict, n: int, seed0: int = 0) -> dict[str, Any]:
+    """Per step: how often the observer's set holds the simulated truth, its 95 % Wilson
+    interval, the per-window binomial bound, and the frequency of the event the recursive set
+    is conditioned on (every window so far held at most q outliers)."""
+    log(f"Monte Carlo {kw}: {missions} missions in chunks of {chunk} ...")
     inside = np.zeros(n, dtype=np.int64)
     ok_count = np.zeros(n, dtype=np.int64)
     inside_given_ok = np.zeros(n, dtype=np.int64)
+    window_ok = np.zeros(n, dtype=np.int64)
     empties = 0
+    widths = np.zeros(4)
     t_mc = time.perf_counter()
     done = 0
-    while done < args.missions:
-        size = min(args.chunk, args.missions - done)
-        sim, truth = simulate_pool(seed=done, n_missions=size)
-        res = solve_pool(sim, q=args.q, m=args.m)
+    while done < missions:
+        size = min(chunk, missions - done)
+        sim, truth = simulate_pool(seed=seed0 + done, n_missions=size)
+        res = solve_pool(sim, q=q, m=m, **kw)
         hit = ((res.boxes.lo <= truth.states) & (truth.states <= res.boxes.hi)).all(-1)
-        ok = _windows_ok(truth.outlier, args.m, args.q)
+        ok = _windows_ok(truth.outlier, m, q)
+        c = np.cumsum(truth.outlier, axis=-1)
+        prev = np.concatenate([np.zeros_like(c[..., :m]), c[..., :-m]], axis=-1)
+        window_ok += ((c - prev) <= q).sum(0)
         inside += hit.sum(0)
         ok_count += ok.sum(0)
         inside_given_ok += (hit & ok).sum(0)
         empties += int(res.empty.sum())
+        widths += res.widths().reshape(-1, 4).mean(0) * size
         done += size
         log(f"  {done} missions, {time.perf_counter() - t_mc:.0f} s")
     bound = res.window_probability
-    freq = inside / args.missions
-    ci = [wilson(int(x), args.missions) for x in inside]
-    rec["monte_carlo"] = {
-        "missions": args.missions, "q": args.q, "m": args.m, "time_s": time.perf_counter() - t_mc,
+    freq = inside / missions
+    ci = [wilson(int(x), missions) for x in inside]
+    return {
+        "missions": missions, "q": q, "m": m, "options": kw,
+        "time_s": time.perf_counter() - t_mc, "mean_width": (widths / missions).tolist(),
         "empty_steps_total": empties,
         "containment_frequency": freq.tolist(),
         "containment_ci95_lo": [c[0] for c in ci], "containment_ci95_hi": [c[1] for c in ci],
         "window_probability_bound": bound.tolist(),
-        "all_windows_ok_frequency": (ok_count / args.missions).tolist(),
+        "window_ok_frequency": (window_ok / missions).tolist(),
+        "all_windows_ok_frequency": (ok_count / missions).tolist(),
         "inside_when_all_windows_ok": int(inside_given_ok.sum()),
         "all_windows_ok_pairs": int(ok_count.sum()),
         "min_containment": float(freq.min()), "step_of_min": int(freq.argmin()),
@@ -140,9 +193,6 @@ def main() -> int:
         "steps_ci_upper_below_bound": int(np.count_nonzero(
             np.array([c[1] for c in ci]) < bound)),
     }
-    rec["loadavg_end"] = os.getloadavg()
-    emit(rec, args.out)
-    return 0
 
 
 if __name__ == "__main__":

@@ -78,3 +78,26 @@ def test_pool_missing_data_folder(tmp_path, capsys):
     assert main(["run", "pool", "--data", str(missing), "--out", str(tmp_path)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "pool_setup.json" in err[0]
+
+
+def test_pool_online_paved_window_only_run(tmp_path):
+    js = tmp_path / "p.json"
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf):
+        rc = main(["run", "pool", "--online", "--window-only", "--paving-heading", "0.3",
+                   "--m", "30", "--out", str(tmp_path), "--json", str(js)])
+    assert rc == 0
+    data = json.loads(js.read_text(), parse_constant=_refuse)
+    assert data["observer"] == "window" and data["paving_heading"] == 0.3
+    assert data["online"]["updates"] == 405 and data["online"]["median_s"] > 0
+    assert "P(x_k in X_k) >=" in data["guarantee"]  # the pure window observer's guarantee
+    assert all(s["cells"] >= 1 for s in data["steps"] if not s["empty"])
+    assert "online updates: median" in buf.getvalue()
+
+
+@pytest.mark.parametrize("bad", [["--paving", "0"], ["--paving-heading", "-0.1"],
+                                 ["--sweeps", "-1"]])
+def test_pool_bad_options(tmp_path, capsys, bad):
+    assert main(["run", "pool", *bad, "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and bad[0].strip("-").replace("-", "_").split("_")[0] in err[0]

@@ -196,7 +196,7 @@ def _online(data, kw: dict):
     from ..scenarios.pool import PoolObserver, PoolResult, window_probabilities
 
     obs = PoolObserver(data, **kw)
-    boxes, rejected, empty, times = [], [], [], []
+    boxes, rejected, empty, cells, times = [], [], [], [], []
     for k in range(data.n):
         t0 = time.perf_counter()
         box, rej, emp = obs.update(data.inputs[k - 1] if k else None, float(data.alpha[k]),
@@ -205,11 +205,12 @@ def _online(data, kw: dict):
         boxes.append(box)
         rejected.append(rej)
         empty.append(emp)
+        cells.append(obs.cells_kept)
     probs = window_probabilities(data.n, kw["m"], kw["q"], data.p_outlier)
     res = PoolResult(Interval._new(np.stack([b.lo for b in boxes]),
                                    np.stack([b.hi for b in boxes])),
                      np.array(rejected), np.array(empty), probs, kw["q"], kw["m"],
-                     float(sum(times)), np.zeros(data.n, dtype=np.int64))
+                     float(sum(times)), np.array(cells), eps=obs.paving)
     return res, np.array(times[1:])  # the first update also loads the kernels
 
 

@@ -121,6 +121,9 @@ class PoolObserver:
         self.ring = po.make_ring(self.m)
         self.work = po.make_work(self.m, self.tapes.lo0.size)
         self.cells = np.empty((0, 4)), np.empty((0, 4))
+        self.paving = (paving, paving_heading) if np.isfinite(self.eps).any() else None
+        #: cells of the paving kept at the last update (0 without a paving)
+        self.cells_kept = 0
         self.k = 0
 
     def update(self, u: Interval | None, alpha: float, d: Interval
@@ -139,7 +142,7 @@ class PoolObserver:
             ul = np.ascontiguousarray(u.lo, dtype=np.float64).reshape(2)
             uh = np.ascontiguousarray(u.hi, dtype=np.float64).reshape(2)
         xl, xh = np.empty(4), np.empty(4)
-        rej, empty, _ = po.observer_update(self.k, ul, uh, float(alpha), float(d.lo),
+        rej, empty, self.cells_kept = po.observer_update(self.k, ul, uh, float(alpha), float(d.lo),
                                            float(d.hi), self.par, self.eps, self.x0.lo,
                                            self.x0.hi, self.restart.lo, self.restart.hi,
                                            self.h[0], self.h[1], self.tapes, self.ring, xl, xh,
