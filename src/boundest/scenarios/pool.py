@@ -46,7 +46,7 @@ def restart_box(data: PoolData) -> Interval:
     vmax = max(float(np.max(np.abs(data.x0.lo[3]))), float(np.max(np.abs(data.x0.hi[3]))),
                float(np.max(np.abs(u.lo[..., 0] + u.lo[..., 1]))),
                float(np.max(np.abs(u.hi[..., 0] + u.hi[..., 1]))))
-    vmax = float(np.nextafter(vmax, np.inf))
+    vmax *= 1.0 + 2.0**-40  # the data's float64 Euler steps may round a few ulps above
     return Interval([seg[:, 0].min(), seg[:, 1].min(), -np.inf, -vmax],
                     [seg[:, 0].max(), seg[:, 1].max(), np.inf, vmax])
 

@@ -34,7 +34,8 @@ holds the state whatever the pings); if even that is empty, ``X_k = P_k``.
 **Rounding.** Every operation is outward rounded, and each Euler step is widened by
 ``2^-50 (|result| + |increment|)`` on each side, which covers the float64 evaluation of
 ``X + dt f(X, u)`` by which the data were made (libm's cos/sin within 1 ulp, three roundings
-in the increment, one in the sum).
+in the increment, one in the sum); each range box is widened by a relative ``2^-40`` for the
+float64 evaluation of the first-hit distance.
 """
 
 from __future__ import annotations
@@ -57,6 +58,7 @@ _mul_lo, _mul_hi = ar._mul_lo.scalar, ar._mul_hi.scalar
 _div_lo, _div_hi = ar._div_lo.scalar, ar._div_hi.scalar
 _sin, _cos = tr._sin.scalar, tr._cos.scalar
 _PAD = 2.0**-50
+_D_PAD = 2.0**-40
 
 # kernel parameters: par = [m, q, sweeps, passes, carry]
 M, Q, SWEEPS, PASSES, CARRY = range(5)
@@ -149,7 +151,9 @@ def _ping(sl, sh, alpha, dl, dh, par, tp, ol, oh, scratch):
     bl, bh = scratch[0][:4], scratch[1][:4]
     bl[0], bh[0], bl[1], bh[1] = sl[0], sh[0], sl[1], sh[1]
     bl[2], bh[2] = _add_lo(sl[2], sh[2], alpha, alpha), _add_hi(sl[2], sh[2], alpha, alpha)
-    bl[3], bh[3] = dl, dh
+    # the data's distance is the float64 evaluation of the first-hit formulas: a relative
+    # 2^-40 covers its rounding (the reading's box holds that float, not the exact distance)
+    bl[3], bh[3] = dl - _D_PAD * abs(dl), dh + _D_PAD * abs(dh)
     if not raycast_box(bl, bh, par[PASSES], 3, tp[0], tp[1], tp[2], tp[3], tp[4], tp[5], tp[6],
                        tp[7], tp[8], tp[9], tp[10], tp[11], tp[12], scratch[2], scratch[3],
                        scratch[4]):
