@@ -21,7 +21,9 @@ measurements after the restart). It never keeps an empty set silently. A wrong b
 cannot be detected.
 
 Everything is batched: a leading batch axis runs many independent missions at once (the same
-inputs or one input box per mission), which is how a Monte Carlo check runs.
+inputs or one input box per mission), which is how a Monte Carlo check runs. This is the
+observer for any model given as Python callables; the pool robot has a compiled one that also
+smooths inside its window (:mod:`boundest.scenarios.pool_observer`).
 """
 
 from __future__ import annotations
