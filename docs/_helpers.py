@@ -1,0 +1,68 @@
+"""Helpers for the executed code blocks of the documentation (markdown-exec).
+
+The pages import this module from a hidden block (``sys.path`` gets ``docs/``); what a reader
+copies is the visible code, which uses only the public API of boundest. markdown-exec captures
+the ``print`` of the page's own code, not ``sys.stdout``: these helpers return text, and the
+page prints it.
+"""
+
+from __future__ import annotations
+
+import base64
+import contextlib
+import io
+import re
+import tempfile
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt
+
+import boundest
+from boundest.cli import main
+
+_DATA = str(Path(boundest.__file__).parent)
+
+
+def img(path_or_fig, alt: str, width: str = "100%") -> str:
+    """An ``<img>`` tag holding the PNG inline (base64), so the site needs no image files."""
+    if isinstance(path_or_fig, (str, Path)):
+        data = Path(path_or_fig).read_bytes()
+    else:
+        buf = io.BytesIO()
+        path_or_fig.savefig(buf, format="png", dpi=100, bbox_inches="tight")
+        plt.close(path_or_fig)
+        data = buf.getvalue()
+    b64 = base64.b64encode(data).decode("ascii")
+    return f'\n<img alt="{alt}" style="width:{width}" src="data:image/png;base64,{b64}">\n'
+
+
+
+
+
+def command(argv: list[str], *, figures: list[tuple[str, str]] | None = None,
+            width: str = "100%", expect: int = 0, max_lines: int = 40) -> str:
+    """Run ``boundest argv --out DIR`` in this process and return, as Markdown, the command, its
+    output (standard output; progress bars go to standard error and are dropped) and the
+    figures it wrote (``(file name, alt text)`` pairs), in that order.
+
+    Raises if the exit code is not ``expect``: a page that documents a broken command fails
+    the build.
+    """
+    with tempfile.TemporaryDirectory() as tmp:
+        out, err = io.StringIO(), io.StringIO()
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            rc = main([*argv, "--out", tmp])
+        if rc != expect:
+            raise RuntimeError(f"boundest {' '.join(argv)} exited {rc}:\n{err.getvalue()}")
+        text = out.getvalue().replace(tmp, "out").replace(_DATA, "<boundest>")
+        text = re.sub(r"[^\S\n]+\n", "\n", text)
+        lines = text.rstrip("\n").split("\n")
+        if len(lines) > max_lines:
+            lines = [*lines[: max_lines - 1], f"... ({len(lines) - max_lines + 1} more lines)"]
+        md = ["```console", f"$ boundest {' '.join(argv)}", *lines, "```"]
+        md += [img(Path(tmp) / name, alt, width) for name, alt in figures or []]
+        return "\n".join(md)
