@@ -82,3 +82,12 @@ def test_set_sequence_counts_boxes_outside_the_zoom():
 def test_set_sequence_refuses_mismatched_labels():
     with pytest.raises(ValueError, match="one label per estimator"):
         plot_set_sequence([[FRAME]], ["a", "b"], FRAME)
+
+
+def test_set_sequence_says_which_sets_are_empty():
+    empty = bd.Subpaving.empty(2)
+    fig = plot_set_sequence([[FRAME, empty], [empty, empty]],
+                            ["causal (RCSE)", "non-causal (NCSE)"], FRAME)
+    assert "NCSE: empty" in fig.axes[1].get_title()
+    assert "RCSE, NCSE: empty" in fig.axes[2].get_title()
+    plt.close(fig)

@@ -21,6 +21,10 @@ SET_STYLES = (("#f4a9a8", "#fdf0b0", "#b0b0b0", "\\\\\\"),
               ("#c0392b", "#f1c40f", "black", "///"), ("#1f77b4", "#aec7e8", "black", "|||"))
 
 
+def _is_empty(d: Interval | Subpaving) -> bool:
+    return d.is_empty() if isinstance(d, Subpaving) else bool(d.is_empty().any())
+
+
 def _hull(d: Interval | Subpaving, frame: Interval) -> Interval | None:
     """The hull of a 2-D domain clipped to ``frame`` (None when empty)."""
     if isinstance(d, Subpaving):
@@ -153,11 +157,13 @@ def plot_set_sequence(rows: Sequence[Sequence[Interval | Subpaving]],
         if truth is not None and k < len(truth):
             ax.plot(truth[k][0], truth[k][1], "x", color="tab:blue", ms=8, mew=2,
                     label="true state")
-        hidden = [(labels[r].split(" ")[-1].strip("()"), _outside_view(row[k], view))
+        short = [lb.split(" ")[-1].strip("()") for lb in labels]
+        hidden = [(short[r], _outside_view(row[k], view))
                   for r, row in enumerate(rows[:-1]) if k < len(row)]
         notes = [f"+{c} {n} box{'es' if c > 1 else ''} out of view" for n, c in hidden if c]
-        if h is None and k < len(last):
-            notes.insert(0, f"{labels[-1]}: empty")
+        empty = [short[r] for r, row in enumerate(rows) if k < len(row) and _is_empty(row[k])]
+        if empty:
+            notes.insert(0, f"{', '.join(empty)}: empty")
         ax.set_xlim(float(view.lo[0]), float(view.hi[0]))
         ax.set_ylim(float(view.lo[1]), float(view.hi[1]))
         ax.set_aspect("equal", adjustable="box")
