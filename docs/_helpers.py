@@ -52,7 +52,9 @@ RESULTS: dict[tuple[str, ...], dict] = {}
 
 
 def _name(argv: list[str]) -> str:
-    return "_".join(a.lstrip("-") for a in argv[1:] or argv).replace("/", "_") or "result"
+    """A file name for the JSON of ``argv``: ``satellite``, ``jaulin2001_boxes``, ``m``."""
+    parts = [Path(a).stem if "/" in a else a.lstrip("-") for a in argv[1:] or argv]
+    return "_".join(parts) or "result"
 
 
 def run_json(argv: list[str], expect: int = 0) -> tuple[dict, str, str]:
