@@ -26,10 +26,12 @@ def pyplot() -> Any:
 
 
 def save_figure(fig: Any, out: str | Path, name: str, dpi: int = 120) -> Path:
-    """Lay out ``fig``, write it to ``out/name.png`` (creating the folder), close it, say so."""
+    """Lay out ``fig`` (unless it has its own layout engine), write it to ``out/name.png``
+    (creating the folder), close it, say so."""
     folder = Path(out)
     folder.mkdir(parents=True, exist_ok=True)
-    fig.tight_layout()
+    if fig.get_layout_engine() is None:
+        fig.tight_layout()
     png = folder / f"{name}.png"
     fig.savefig(png, dpi=dpi)
     pyplot().close(fig)

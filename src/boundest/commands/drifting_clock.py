@@ -33,10 +33,10 @@ def run(args: argparse.Namespace) -> int:
         truth = dc.ClockTruth() if args.data is None else None
         for name, fn, title in (
                 ("clock_distance", plot_clock_distance,
-                 "ephemeris [y](.) and measurements, before (blue) / after (red) (Fig. 11)"),
+                 "ephemeris [y](.) and the measurements (Rohou et al. 2018, Fig. 11)"),
                 ("clock_drift", plot_clock_drift,
-                 "drift [h](.), [t_i] before (blue) / after (red), truth (Fig. 12)")):
-            fig, ax = plt.subplots(figsize=(9, 5))
+                 "clock drift [h](.) and the times [t_i] (Rohou et al. 2018, Fig. 12)")):
+            fig, ax = plt.subplots(figsize=(9, 5.5))
             fn(res, truth=truth, ax=ax)
             ax.set_title(title)
             save_figure(fig, args.out, name)

@@ -33,9 +33,9 @@ def run(args: argparse.Namespace) -> int:
     pyplot()  # the file-only backend, before plot_set_sequence makes its figure
     fig = plot_set_sequence([res.rcse.x, res.ncse.x], ["causal (RCSE)", "non-causal (NCSE)"],
                             jw.FRAME)
-    fig.suptitle("x(k), k = 0..10: causal and non-causal sets (Jaulin et al. 2001, Fig. 7)",
-                 fontsize=10)
-    save_figure(fig, args.out, f"jaulin2001_{domains}", dpi=130)
+    fig.suptitle(f"x(k), k = 0..{K}: causal and non-causal sets (Jaulin et al. 2001, Fig. 7);\n"
+                 "each panel zoomed on the non-causal set (ticks differ)", fontsize=10)
+    save_figure(fig, args.out, f"jaulin2001_{domains}", dpi=110)
     write_json(data, args.json)
     return 1 if empty else 0
 

@@ -41,13 +41,19 @@ def run(args: argparse.Namespace) -> int:
                                                   for i in range(4)))
         fig, ax = plt.subplots(figsize=(6.5, 6))
         plot_boxes(Interval._new(res.x_lo[:, 0], res.x_hi[:, 0]),
-                   Interval._new(res.x_lo[:, 1], res.x_hi[:, 1]), ax=ax)
+                   Interval._new(res.x_lo[:, 1], res.x_hi[:, 1]), ax=ax,
+                   label="box [x1](k) x [x2](k), one per k")
         ax.plot(0, 0, "o", color="tab:green", ms=10, label="earth")
-        ax.set_xlabel("x1")
-        ax.set_ylabel("x2")
+        ax.set_xlabel("x1 (length unit of the model, G M = 1)")
+        ax.set_ylabel("x2 (length unit of the model)")
         ax.set_aspect("equal")
-        ax.set_title(f"[x1](k) x [x2](k), k = 0..{meas.k_max + 1} (Jaulin 2002, Fig. 4)")
-        ax.legend()
+        ax.set_title(f"[x1](k) x [x2](k), k = 0..{meas.k_max} (Jaulin 2002, Fig. 4)")
+        for k, dx in ((0, -12), (meas.k_max, -12)):
+            b = res.box(k)
+            ax.annotate(f"k = {k}", ((b.lo[0] + b.hi[0]) / 2, (b.lo[1] + b.hi[1]) / 2),
+                        xytext=(dx, 0), textcoords="offset points", ha="right", va="center",
+                        fontsize=9, arrowprops=dict(arrowstyle="-", color="0.3", lw=0.8))
+        ax.legend(loc="center", bbox_to_anchor=(0.55, 0.45), fontsize=8)
         save_figure(fig, args.out, f"satellite_k{meas.k_max}")
     write_json(res.to_json(), args.json)
     return 0 if res.consistent else 1

@@ -72,6 +72,8 @@ class TreeSCSP:
         The constraints; the graph they form must be a tree over all the variables (connected,
         ``len(variables) - 1`` arcs, no cycle), else ValueError.
 
+    Notes
+    -----
     The methods take the domains as a mapping ``variable -> domain`` and return a new dict; the
     argument is not modified.
     """

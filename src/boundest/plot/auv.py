@@ -63,8 +63,9 @@ def plot_auv_map(data: AuvData, results: list[AuvResult], truth: AuvTruth | None
             ax.plot([pm[k, 1], mm[j, 1]], [pm[k, 0], mm[j, 0]], color=DET, lw=0.8, ls="--")
         ax.plot([], [], color=DET, lw=0.8, ls="--", label="detection (vehicle to mine)")
         for j in range(m.shape[0]):
-            ax.annotate(f"mine {j}", (mm[j, 1], mm[j, 0]), xytext=(4, 4),
-                        textcoords="offset points", fontsize=8, color=MINE)
+            ax.annotate(f"mine {j}", (m.hi[j, 1], m.hi[j, 0]), xytext=(3, 3),
+                        textcoords="offset points", fontsize=8, color="#a04000",
+                        bbox=dict(facecolor="white", alpha=0.8, edgecolor="none", pad=1))
     if truth is not None:
         ax.plot(truth.p[:, 1], truth.p[:, 0], color=TRUTH, lw=0.6, label="true path")
         ax.plot(truth.mines[:, 1], truth.mines[:, 0], "k*", ms=6, label="true mine")

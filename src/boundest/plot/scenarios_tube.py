@@ -31,20 +31,23 @@ def plot_range_only_diagonal(res: RangeOnlyResult, ax: Any = None,
     import matplotlib as mpl
 
     ax = _axes(ax)
-    artists = [ax.axvspan(a, b, color="0.85", zorder=0)
-               for a, b in zip(res.meas.t.lo, res.meas.t.hi, strict=True)]
+    artists = [ax.axvspan(a, b, color="0.85", zorder=0,
+                          label="measurement time intervals [t_i]" if i == 0 else None)
+               for i, (a, b) in enumerate(zip(res.meas.t.lo, res.meas.t.hi, strict=True))]
     colours = mpl.colormaps[cmap](np.linspace(0, 0.9, max(len(res.diag), 1)))
+    n = len(res.diag)
     for k, (d, c) in enumerate(zip(res.diag, colours, strict=False)):
         d = np.where(np.isfinite(d), d, np.nan)
-        last = k == len(res.diag) - 1
+        last = k == n - 1
+        label = (f"iteration {k + 1}" if k == 0 or last else
+                 (f"iterations 2..{n - 1} (dark to light)" if k == 1 else None))
         artists += ax.plot(res.diag_t, d, color="tab:red" if last else c,
-                           linewidth=1.6 if last else 0.9,
-                           label=f"iteration {k + 1}" if k in (0, len(res.diag) - 1) else None)
+                           linewidth=1.6 if last else 0.9, label=label)
     ax.set_yscale("log")
     ax.set_xlabel("t (s)")
-    ax.set_ylabel("d([x1](t) x [x2](t)) (m)")
+    ax.set_ylabel("diagonal of [x1](t) x [x2](t) (m)")
     ax.set_xlim(res.x.t[0], res.x.t[-1])
-    ax.legend(loc="upper right")
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
     return artists
 
 
@@ -59,7 +62,8 @@ def plot_range_only_map(res: RangeOnlyResult, truth: RobotTruth | None = None, a
     ax = _axes(ax)
     x = res.x
     artists = [plot_boxes(x.slices[:, 0], x.slices[:, 1], ax=ax, facecolor="lightgrey",
-                          edgecolor="none", alpha=0.6)]
+                          edgecolor="none", alpha=0.6,
+                          label="position tube: one box per time slice")]
     mid = (x.t[:-1] + x.t[1:]) / 2
     inside = np.zeros(mid.size, dtype=bool)
     for a, b in zip(res.t.lo, res.t.hi, strict=True):
@@ -67,19 +71,26 @@ def plot_range_only_map(res: RangeOnlyResult, truth: RobotTruth | None = None, a
             inside |= (mid >= a) & (mid <= b)
     if inside.any():
         artists.append(plot_boxes(x.slices[inside, 0], x.slices[inside, 1], ax=ax,
-                                  facecolor="tab:blue", edgecolor="none", alpha=0.5))
+                                  facecolor="tab:blue", edgecolor="none", alpha=0.5,
+                                  label="slices within a contracted [t_i]"))
     bc = (res.meas.beacons.lo + res.meas.beacons.hi) / 2
     for k, (bx, by) in enumerate(bc):
-        artists.append(ax.add_patch(Circle((bx, by), range_max, fill=False, color="tab:red",
-                                           linestyle="--", linewidth=0.8)))
-        artists.append(ax.add_patch(Rectangle((bx - 1.5, by - 1.5), 3, 3, color="tab:red")))
+        artists.append(ax.add_patch(Circle(
+            (bx, by), range_max, fill=False, color="tab:red", linestyle="--", linewidth=0.8,
+            label=f"beacon signal range ({range_max:g} m)" if k == 0 else None)))
+        artists.append(ax.add_patch(Rectangle((bx - 1.5, by - 1.5), 3, 3, color="tab:red",
+                                              label="beacon" if k == 0 else None)))
         name = res.meas.beacon_names[k] if res.meas.beacon_names else str(k)
-        artists.append(ax.annotate(name, (bx + 2, by + 2), color="tab:red"))
+        artists.append(ax.annotate(name, (bx, by - 2.5), color="darkred", ha="center",
+                                   va="top", fontsize=9,
+                                   bbox=dict(facecolor="white", alpha=0.7, edgecolor="none",
+                                             pad=1)))
     if truth is not None:
         s = np.linspace(x.t[0], x.t[-1], 4 * x.n_slices + 1)
         p = truth.states(s)
-        artists += ax.plot(p[:, 0], p[:, 1], color="black", linewidth=1.0, label="truth")
-        ax.legend(loc="upper left")
+        artists += ax.plot(p[:, 0], p[:, 1], color="black", linewidth=1.0,
+                           label="true path (simulation)")
+    ax.legend(loc="upper right", fontsize=8)
     ax.set_aspect("equal")
     ax.set_xlabel("x1 (m)")
     ax.set_ylabel("x2 (m)")
@@ -93,13 +104,16 @@ def plot_clock_distance(res: ClockResult, truth: ClockTruth | None = None,
     ``[h]^{-1}(tau_i) x [z_i]`` from the derivative bounds alone) and after (red) contraction."""
     ax = _axes(ax)
     artists = plot_tube(res.y, ax=ax, color="tab:grey", alpha=0.4, gates=False,
-                        truth=(lambda s: truth.distance(s)) if truth is not None else None)
+                        truth=(lambda s: truth.distance(s)) if truth is not None else None,
+                        label="tube [y](t)", truth_label="true distance (simulation)")
     artists.append(plot_boxes(res.t_initial, res.meas.z, ax=ax, facecolor="tab:blue",
-                              edgecolor="navy", alpha=0.35))
+                              edgecolor="navy", alpha=0.35,
+                              label="measurement [t_i] x [z_i], [t_i] from the drift bounds"))
     artists.append(plot_boxes(res.t, res.z, ax=ax, facecolor="tab:red", edgecolor="darkred",
-                              alpha=0.6))
-    ax.set_xlabel("t (s)")
+                              alpha=0.6, label="the same after contraction"))
+    ax.set_xlabel("t: reference time (s)")
     ax.set_ylabel("y(t): boat-beacon distance (m)")
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2, fontsize=8)
     return artists
 
 
@@ -111,13 +125,16 @@ def plot_clock_drift(res: ClockResult, truth: ClockTruth | None = None,
     ax = _axes(ax)
     artists = plot_tube(res.h, ax=ax, color="tab:grey", alpha=0.45, gates=False,
                         truth=(lambda s: truth.drift(s)) if truth is not None else None,
-                        truth_color="tab:blue")
+                        truth_color="black", label="tube [h](t)",
+                        truth_label="true drift (simulation)")
     tau = res.meas.tau
     eps = Interval._new(tau.lo - 0.08, tau.hi + 0.08)
     artists.append(plot_boxes(res.t_initial, eps, ax=ax, facecolor="tab:blue",
-                              edgecolor="navy", alpha=0.35))
+                              edgecolor="navy", alpha=0.35,
+                              label="[t_i] at clock time tau_i, from the drift bounds"))
     artists.append(plot_boxes(res.t, eps, ax=ax, facecolor="tab:red", edgecolor="darkred",
-                              alpha=0.7))
+                              alpha=0.7, label="[t_i] after contraction"))
     ax.set_xlabel("t: reference time (s)")
     ax.set_ylabel("tau = h(t): clock time (s)")
+    ax.legend(loc="upper left", fontsize=8)
     return artists

@@ -21,7 +21,8 @@ def plot_tube(tube: Tube, ax: Any = None, *, component: int | None = None,
               truth: Any = None, boxes: tuple[Interval, Interval] | None = None,
               color: str = "tab:blue", alpha: float = 0.35, gates: bool | None = None,
               label: str | None = None, truth_color: str = "black",
-              box_color: str = "tab:red") -> list[Any]:
+              box_color: str = "tab:red", truth_label: str | None = None,
+              box_label: str | None = None) -> list[Any]:
     """Draw a scalar tube (or one ``component`` of a tube vector) against time.
 
     Parameters
@@ -32,8 +33,13 @@ def plot_tube(tube: Tube, ax: Any = None, *, component: int | None = None,
         Measurement boxes ``[t_i] x [z_i]`` (1-D interval arrays).
     gates : bool, optional
         Draw the gates as vertical segments (default: when there are at most 500 slices).
+    label, truth_label, box_label : str, optional
+        Legend entries of the tube, the truth and the boxes.
 
-    Unbounded parts of the tube are not drawn. Returns the artists drawn.
+    Returns
+    -------
+    list
+        The artists drawn. Unbounded parts of the tube are not drawn.
     """
     if tube.is_vector:
         if component is None:
@@ -61,10 +67,10 @@ def plot_tube(tube: Tube, ax: Any = None, *, component: int | None = None,
             ys = np.asarray(truth(ts), dtype=np.float64)
         else:
             ts, ys = (np.asarray(a, dtype=np.float64) for a in truth)
-        artists += ax.plot(ts, ys, color=truth_color, linewidth=1.0)
+        artists += ax.plot(ts, ys, color=truth_color, linewidth=1.0, label=truth_label)
     if boxes is not None:
         artists.append(plot_boxes(boxes[0], boxes[1], ax=ax, facecolor=box_color,
-                                  edgecolor=box_color, alpha=0.5))
+                                  edgecolor=box_color, alpha=0.5, label=box_label))
     ax.set_xlim(t[0], t[-1])
     ax.autoscale_view(scalex=False)
     return artists

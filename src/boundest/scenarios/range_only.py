@@ -13,10 +13,10 @@ the position unknown. Range measurements ``z_i = |x12(t_i) - b_k|`` to three bea
     y_k = |x12 - b_k|,  w_k = x4 cos(x3 - atan2(x2 - b_k2, x1 - b_k1)),  y_k' = w_k,
     z_i = y_k(t_i)                                          (CtcEval, uncertain t_i)
 
-``w_k`` is the derivative of the distance, ``(x12 - b_k).v12 / y_k`` of the seed, written with
+``w_k`` is the derivative of the distance, ``(x12 - b_k).v12 / y_k`` of the paper, written with
 the bearing of the robot from the beacon: the two are equal wherever ``x12 != b_k``, and this
 form gives ``|w_k| <= |x4|`` even while the position is still unbounded (the quotient form gives
-nothing then, and no measurement could ever be used). The truth used by the seed starts at
+nothing then, and no measurement could ever be used). The truth used by the paper starts at
 ``x(0) = (0, 0, pi/2, 0)`` with the centre of equation 14 as input.
 """
 

@@ -48,7 +48,7 @@ __all__ = [
 DELTA = 0.5
 W_BOUND = 0.01
 NOISE = 0.1
-#: Initial state used by the seed to generate its data (Remark 2).
+#: Initial state used by Jaulin 2002 to generate its data (Remark 2).
 X0_TRUE = (4.0, 0.5, -0.2, 0.5)
 #: Sign restrictions of Remark 2 on x(0).
 X0_DOMAINS = ((0.0, np.inf), (0.0, np.inf), (-np.inf, 0.0), (0.0, np.inf))

@@ -34,6 +34,8 @@ class CtcSlices:
     variables : list of str, optional
         Variable order when ``ctc`` is given as constraints.
 
+    Notes
+    -----
     The domains passed to ``contract`` supply the variables in order: a scalar tube one, a tube
     vector of dimension ``d`` d of them, and an ``Interval`` (scalar or box) a time-invariant
     value, contracted to the intersection of its contractions over all times. If the constraint
