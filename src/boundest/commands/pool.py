@@ -126,20 +126,21 @@ def run(args: argparse.Namespace) -> int:
 
     consistent = ping_consistency(data, res)
     snaps = np.unique(np.rint(np.linspace(0, data.n - 1, 6)).astype(int))
-    fig, axes = plt.subplots(2, 3, figsize=(15, 6.4))
+    fig, axes = plt.subplots(2, 3, figsize=(15, 7.4), layout="constrained")
     for i, (ax, k) in enumerate(zip(axes.flat, snaps, strict=False)):
         last = i == len(snaps) - 1
         plot_pool_snapshot(data, res, int(k), consistent, ax=ax, pings=last)
-        ax.set_title(f"t = {data.t[k]:.2f} s (k = {k}): (x, y) box"
+        ax.set_title(f"t = {data.t[k]:.2f} s (k = {k})"
                      + (f", the window's {window_of(res, int(k)).size} pings" if last else ""),
                      fontsize=9)
-        if last:
-            ax.legend(loc="lower left", fontsize=6)
     for ax in list(axes.flat)[len(snaps):]:
         ax.set_visible(False)
-    fig.suptitle(f"pool robot, q = {args.q}, m = {args.m}. Last panel: each ping of the window "
-                 "drawn from the box centre at its time along theta_centre + alpha, length "
-                 "d_mid; grey: the ray-cast contractor empties (X_j, ping j)", fontsize=10)
+    handles, labels = axes.flat[len(snaps) - 1].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="outside lower center", ncol=4, fontsize=8, frameon=False)
+    fig.suptitle(f"pool robot, q = {args.q}, m = {args.m}: the (x, y) box at six times.\n"
+                 "Last panel: each ping of the window drawn from the box centre at its time "
+                 "along theta_centre + alpha, length d_mid; grey: the ray-cast contractor "
+                 "empties (X_j, ping j)", fontsize=10)
     save_figure(fig, args.out, "pool_snapshots")
 
     fig, ax = plt.subplots(figsize=(7, 7))

@@ -105,15 +105,16 @@ def plot_pool_snapshot(data: PoolData, res: PoolResult, k: int,
         bounded = np.isfinite(th.lo) & np.isfinite(th.hi)  # no heading after a restart
         beta = np.where(bounded, c[j, 2] + data.alpha[j], np.nan)
         ok = consistent[j]
-        _rays(ax, c[j, 0][ok], c[j, 1][ok], beta[ok], d[ok], colors=KEPT, lw=0.6, alpha=0.8)
+        _rays(ax, c[j, 0][ok], c[j, 1][ok], beta[ok], d[ok], colors=KEPT, lw=0.5, alpha=0.5)
         _rays(ax, c[j, 0][~ok], c[j, 1][~ok], beta[~ok], d[~ok], colors=REJECTED, lw=1.6,
               zorder=3)
         ax.plot([], [], color=KEPT, lw=0.8, label=f"kept ping ({int(ok.sum())})")
         ax.plot([], [], color=REJECTED, lw=1.6,
                 label=f"rejected ping ({int((~ok).sum())})")
     b = res.boxes[k]
-    _rects(ax, b.lo[None, :2], b.hi[None, :2], facecolor=BOX, edgecolor=BOX, alpha=0.5, lw=1)
-    ax.plot([], [], "s", color=BOX, alpha=0.6, label="(x, y) box")
+    _rects(ax, b.lo[None, :2], b.hi[None, :2], facecolor=BOX, edgecolor=PATH, alpha=0.7, lw=1,
+           zorder=4)
+    ax.plot([], [], "s", color=BOX, alpha=0.7, mec=PATH, label="(x, y) box at this time")
     if res.paving is not None and res.cells[k]:
         cells = res.paving[k, : min(int(res.cells[k]), res.paving.shape[-2])]
         _rects(ax, cells.lo[:, :2], cells.hi[:, :2], facecolor="none", edgecolor=CELL, lw=0.6)
@@ -142,7 +143,7 @@ def plot_pool_emission(data: PoolData, consistent: NDArray[np.bool_], k: int | N
               colors=colour, lw=3, zorder=z)
         ax.plot([], [], color=colour, lw=0.8, label=f"{name} ping: ray to d_mid "
                 f"({int(sel.sum())})")
-    ax.plot([], [], color="0.3", lw=2.5, label="range box [d_lo, d_hi] (thick)")
+        ax.plot([], [], color=colour, lw=3, label=f"range box [d_lo, d_hi] of a {name} ping")
     ax.plot([0], [0], "^", color=PATH, ms=9, label="robot (heading +x)")
     ax.set_aspect("equal")
     end = np.stack([mid * np.cos(a), mid * np.sin(a)], -1)
@@ -171,7 +172,8 @@ def plot_pool_trajectory(data: PoolData, res: PoolResult, every: int = 10,
     if restarts.size:
         ax.plot(c[restarts - 1, 0], c[restarts - 1, 1], "x", color="r", ms=8,
                 label="restart (empty set)")
-    ax.legend(loc="upper right", fontsize=7)
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=3, fontsize=8,
+              frameon=False)
     return ax
 
 
