@@ -190,8 +190,10 @@ def monte_carlo(solve_pool, simulate_pool, missions: int, chunk: int, q: int, m:
         "all_windows_ok_pairs": int(ok_count.sum()),
         "min_containment": float(freq.min()), "step_of_min": int(freq.argmin()),
         "steps_below_bound": int(np.count_nonzero(freq < bound)),
+        # (a bound of exactly 1, before the window fills, against an upper end rounded to
+        # 1 - 1e-16 is not below it)
         "steps_ci_upper_below_bound": int(np.count_nonzero(
-            np.array([c[1] for c in ci]) < bound)),
+            np.array([c[1] for c in ci]) < bound - 1e-12)),
     }
 
 
