@@ -176,3 +176,19 @@ def test_worker_killed_mid_run_loses_and_duplicates_nothing(client):
                                   progress=False))
     assert was_busy
     assert table["value"].tolist() == [v * v for v in values]
+
+
+def test_pool_monte_carlo_on_cluster_is_the_in_process_count(client):
+    from boundest.scenarios.pool_mc import pool_monte_carlo
+
+    # short missions (120 pings, 1.5 windows): one batch of two in-process, two tasks of one
+    ref = pool_monte_carlo(2, chunk=2, n_samples=120, progress=False)
+    got = pool_monte_carlo(2, chunk=1, n_samples=120, executor=client.get_executor(),
+                           progress=False)
+    for k in ("inside", "windows_ok", "inside_when_ok", "window_probability", "t"):
+        assert np.array_equal(getattr(ref, k), getattr(got, k)), k
+    assert got.empty_steps == ref.empty_steps and got.missions == 2
+    assert (got.inside_when_ok == got.windows_ok).all()  # the guarantee, mission by mission
+    lo, hi = got.ci()
+    freq = got.frequency()
+    assert ((lo <= freq) & (freq <= hi)).all()

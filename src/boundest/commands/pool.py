@@ -57,6 +57,12 @@ def run(args: argparse.Namespace) -> int:
 
     if args.q < 0 or args.m < 1:
         raise ValueError(f"need --q >= 0 and --m >= 1, got --q {args.q} --m {args.m}")
+    if args.monte_carlo is not None or args.scheduler or args.workers is not None:
+        from .pool_mc import run_monte_carlo
+
+        if args.monte_carlo is None:
+            raise ValueError("--scheduler and --workers go with --monte-carlo N")
+        return run_monte_carlo(args)
     start = time.perf_counter()
     data = load_pool(args.data)
     read_s = time.perf_counter() - start
@@ -170,4 +176,7 @@ def register(runs: argparse._SubParsersAction) -> None:
                    "(default: out)")
     p.add_argument("--json", help="write the summary and every step's box as JSON to this file "
                    "(strict JSON: docs/json.md)")
+    from .pool_mc import add_options
+
+    add_options(p)
     p.set_defaults(func=run)
