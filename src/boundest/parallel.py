@@ -72,10 +72,10 @@ def _short_repr(value: Any) -> str:
 
 
 def _chunk_task(fn: Callable[[Any], Any], start: int, items: Sequence[Any]
-                ) -> tuple[list[Any], float] | _Failure:
-    """``[fn(item) for item in items]`` and the seconds it took, on a worker; a failure names
-    the input (its index in the whole run is ``start + j``)."""
-    t0 = time.perf_counter()
+                ) -> tuple[list[Any], float, float] | _Failure:
+    """``[fn(item) for item in items]``, the seconds it took and the CPU seconds of its thread,
+    on a worker; a failure names the input (its index in the whole run is ``start + j``)."""
+    t0, c0 = time.perf_counter(), time.thread_time()
     out = []
     for j, item in enumerate(items):
         try:
@@ -83,7 +83,7 @@ def _chunk_task(fn: Callable[[Any], Any], start: int, items: Sequence[Any]
         except Exception as exc:
             return _Failure(start + j, _short_repr(item), f"{type(exc).__name__}: {exc}",
                             traceback.format_exc())
-    return out, time.perf_counter() - t0
+    return out, time.perf_counter() - t0, time.thread_time() - c0
 
 
 def executor_workers(executor: Executor | None) -> int:
@@ -136,8 +136,8 @@ def map_chunked(fn: Callable[[Any], Any], items: Iterable[Any],
     desc : str, optional
         The bar's label.
     stats : dict, optional
-        Filled with ``tasks``, ``chunk``, ``compute_s`` (seconds each task spent in ``fn``, in
-        task order) and ``wall_s``.
+        Filled with ``tasks``, ``chunk``, ``compute_s`` and ``cpu_s`` (seconds and CPU seconds
+        each task spent in ``fn``, in task order) and ``wall_s``.
 
     Returns
     -------
@@ -189,6 +189,7 @@ def map_chunked(fn: Callable[[Any], Any], items: Iterable[Any],
                     fut.cancel()
     if stats is not None:
         stats.update(tasks=len(starts), chunk=chunk, compute_s=[p[1] for p in parts],
+                     cpu_s=[p[2] for p in parts],
                      wall_s=time.perf_counter() - t0)
     return [r for p in parts for r in p[0]]
 
