@@ -99,6 +99,42 @@ def _same_paving(a, b) -> bool:
             and np.array_equal(a.inside, b.inside))
 
 
+#: what the projection assumes of a real cluster's network (10 GbE, to the client)
+NETWORK_BYTES_PER_S = 1.0e9
+
+
+def project(rec: dict, workers: tuple[int, ...] = (1, 2, 10, 100)) -> dict:
+    """Projected wall-clock time on ``workers`` single-threaded workers, from the measured
+    per-task costs and data sizes (docs/distributed.md explains the model)."""
+    two = rec["workers"]["2"]
+    pv, bt = two["paving"], two["batch"]
+    one = rec["workers"]["1"]
+    out: dict = {"network_bytes_per_s": NETWORK_BYTES_PER_S, "paving": {}, "batch": {}}
+    # paving: serial head and merge, the result sent to the client, the tasks' CPU work
+    # spread over the workers, plus the largest task (parts differ in size), plus the
+    # per-task overhead, and never faster than the scheduler's task rate
+    work = one["paving"]["task_cpu_s_total"]
+    ratio = pv["task_compute_s_max"] / (pv["task_compute_s_total"] / pv["tasks"])
+    sched = two["noop_task_s"]
+    for w in workers:
+        tasks = max(rec["args"]["tasks"], 4 * w)
+        biggest = ratio * work / tasks
+        t = (pv["head_s"] + pv["merge_s"] + rec["paving"]["result_bytes"] / NETWORK_BYTES_PER_S
+             + max(work / w + biggest + -(-tasks // w) * max(pv["overhead_per_task_s"], 0.0),
+                   tasks * sched))
+        out["paving"][str(w)] = {"tasks": tasks, "time_s": t}
+    n = rec["batch"]["trajectories"]
+    per_row = one["batch"]["task_cpu_s_total"] / n
+    for w in workers:
+        chunk = max(1, -(-n // (4 * w)))
+        tasks = -(-n // chunk)
+        t = (-(-tasks // w) * (chunk * per_row + max(bt["overhead_per_task_s"], 0.0))
+             + n * rec["batch"]["row_bytes"] / NETWORK_BYTES_PER_S)
+        out["batch"][str(w)] = {"tasks": tasks, "chunk": chunk,
+                                "time_s": max(t, tasks * sched)}
+    return out
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--out")
@@ -109,9 +145,19 @@ def main() -> int:
     ap.add_argument("--kmax", type=int, default=200)
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--workers", default="1,2")
+    ap.add_argument("--reproject", metavar="JSON",
+                    help="only recompute the projection of an earlier run's JSON file")
     ap.add_argument("--dask-malloc-trim", action="store_true",
                     help="keep Dask's default MALLOC_TRIM_THRESHOLD_=65536 in the workers")
     args = ap.parse_args()
+    if args.reproject:
+        import json
+        from pathlib import Path
+
+        rec = json.loads(Path(args.reproject).read_text())
+        rec["projection"] = project(rec)
+        emit(rec, args.reproject)
+        return 0
 
     import dask
     from distributed import Client, LocalCluster
@@ -229,6 +275,8 @@ def main() -> int:
     rec["paving"] = paving
     rec["batch"] = batch
     rec["workers"] = results
+    if "1" in results and "2" in results:
+        rec["projection"] = project(rec)
     rec["loadavg_end"] = os.getloadavg()
     emit(rec, args.out)
     return 0
