@@ -117,12 +117,16 @@ def project(rec: dict, workers: tuple[int, ...] = (1, 2, 10, 100)) -> dict:
     ratio = pv["task_compute_s_max"] / (pv["task_compute_s_total"] / pv["tasks"])
     sched = two["noop_task_s"]
     for w in workers:
-        tasks = max(rec["args"]["tasks"], 4 * w)
-        biggest = ratio * work / tasks
-        t = (pv["head_s"] + pv["merge_s"] + rec["paving"]["result_bytes"] / NETWORK_BYTES_PER_S
-             + max(work / w + biggest + -(-tasks // w) * max(pv["overhead_per_task_s"], 0.0),
-                   tasks * sched))
-        out["paving"][str(w)] = {"tasks": tasks, "time_s": t}
+        best = None
+        for tasks in (64, 128, 256, 512, 1024, 2048):  # the best cut for w workers
+            biggest = ratio * work / tasks
+            t = (pv["head_s"] + pv["merge_s"]
+                 + rec["paving"]["result_bytes"] / NETWORK_BYTES_PER_S
+                 + max(work / w + biggest + -(-tasks // w) * max(pv["overhead_per_task_s"], 0.0),
+                       tasks * sched))
+            if best is None or t < best["time_s"]:
+                best = {"tasks": tasks, "time_s": t}
+        out["paving"][str(w)] = best
     n = rec["batch"]["trajectories"]
     per_row = one["batch"]["task_cpu_s_total"] / n
     for w in workers:
