@@ -33,7 +33,6 @@ from concurrent.futures import Executor, Future, as_completed
 from typing import Any
 
 import numpy as np
-from tqdm.auto import tqdm
 
 __all__ = ["BatchTable", "TaskError", "client_executor", "executor_workers", "map_chunked",
            "run_batch"]
@@ -150,6 +149,8 @@ def map_chunked(fn: Callable[[Any], Any], items: Iterable[Any],
         When a call raises (or a task cannot be run): the failing input's index and repr and the
         error; the tasks not started yet are cancelled.
     """
+    from tqdm.auto import tqdm  # here, not at import: boundest's import stays light
+
     items = list(items)
     n = len(items)
     if chunk is None:
