@@ -13,7 +13,7 @@ docs/distributed.md projects the time on 10 and 100 workers.
   workers, and every true state inside its enclosure.
 - Dask's nannies start workers with ``MALLOC_TRIM_THRESHOLD_=65536``, which makes glibc map
   and unmap every large NumPy temporary (the kernels' working arrays): the same paving task ran
-  about 40 % slower in such a worker than in-process. The benchmark removes it from the
+  30-40 % slower in such a worker than in-process. The benchmark removes it from the
   workers' environment unless ``--dask-malloc-trim`` is given (docs/distributed.md).
 - Overhead: ``o_task`` = (workers x wall of the tasks - seconds the tasks computed) / tasks,
   i.e. scheduling, serialisation, transfers and idle time charged to each task; also the
@@ -166,7 +166,7 @@ def main() -> int:
     import dask
     from distributed import Client, LocalCluster
 
-    if not args.dask_malloc_trim:  # docs/distributed.md: it slows NumPy temporaries by ~40 %
+    if not args.dask_malloc_trim:  # docs/distributed.md: it slowed a paving task by 30-40 %
         env = dict(dask.config.get("distributed.nanny.pre-spawn-environ"))
         env.pop("MALLOC_TRIM_THRESHOLD_", None)
         dask.config.set({"distributed.nanny.pre-spawn-environ": env})
