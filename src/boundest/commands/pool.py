@@ -64,12 +64,20 @@ def run(args: argparse.Namespace) -> int:
 
     if args.q < 0 or args.m < 1:
         raise ValueError(f"need --q >= 0 and --m >= 1, got --q {args.q} --m {args.m}")
+    if args.monte_carlo is not None or args.scheduler or args.workers is not None:
+        from .pool_mc import run_monte_carlo
+
+        if args.monte_carlo is None:
+            raise ValueError("--scheduler and --workers go with --monte-carlo N")
+        return run_monte_carlo(args)
     start = time.perf_counter()
     data = load_pool(args.data)
     read_s = time.perf_counter() - start
     print(f"pool robot: {data.n} pings over {data.n * data.dt:.1f} s (dt = {data.dt:g} s), "
           f"outlier probability {data.p_outlier:g} per ping (data: {data.source}; read in "
           f"{read_s:.2f} s)")
+    if args.sweeps is None:
+        args.sweeps = 1
     kw = {"q": args.q, "m": args.m, "sweeps": args.sweeps, "carry": not args.window_only,
           "paving": args.paving, "paving_heading": args.paving_heading}
     paved = args.paving is not None or args.paving_heading is not None
@@ -223,9 +231,10 @@ def register(runs: argparse._SubParsersAction) -> None:
                    help="outliers allowed in a window (default 8)")
     p.add_argument("--m", type=int, default=80,
                    help="window length in pings (default 80: one sonar revolution)")
-    p.add_argument("--sweeps", type=int, default=1,
-                   help="smoothing rounds inside the window per ping (default 1; 0: the plain "
-                   "recursive box observer, about 15x faster and wider)")
+    p.add_argument("--sweeps", type=int,
+                   help="smoothing rounds inside the window per ping (default 1, with "
+                   "--monte-carlo 0; 0: the plain recursive box observer, about 50x faster "
+                   "and wider)")
     p.add_argument("--paving", type=float, metavar="EPS",
                    help="pave (x, y) of each set into cells of side EPS metres and keep the "
                    "hull of the cells whose window is consistent (tighter, slower)")
@@ -243,4 +252,7 @@ def register(runs: argparse._SubParsersAction) -> None:
                    "(default: out)")
     p.add_argument("--json", help="write the summary and every step's box as JSON to this file "
                    "(strict JSON: docs/json.md)")
+    from .pool_mc import add_options
+
+    add_options(p)
     p.set_defaults(func=run)

@@ -26,7 +26,11 @@ True
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable, Sequence
+from concurrent.futures import Executor
+from dataclasses import dataclass
+from itertools import pairwise
 
 import numpy as np
 from numpy.typing import NDArray
@@ -34,6 +38,7 @@ from numpy.typing import NDArray
 from ..ctc import Contractor, CtcFwdBwd, Union
 from ..expr import Expr, variables
 from ..interval import Interval, as_interval
+from ..parallel import map_chunked
 from .subpaving import Subpaving, box_difference
 
 __all__ = ["separators", "sivia"]
@@ -123,7 +128,8 @@ def sivia(box: Interval, *, test: Test | None = None, ctc_in: Contractor | None 
           ctc_out: Contractor | None = None, f: Expr | Sequence[Expr] | None = None,
           y: Interval | None = None, eps: float = 1e-2, max_boxes: int | None = None,
           keep_outside: bool = False, variables: Sequence[str] | None = None,
-          batch: int = 16384) -> Subpaving:
+          batch: int = 16384, executor: Executor | None = None, split: int = 16384,
+          tasks: int = 64, progress: bool | None = False) -> Subpaving:
     """Set inversion of ``{x in box : f(x) in y}`` by a subpaving.
 
     Parameters
@@ -149,13 +155,30 @@ def sivia(box: Interval, *, test: Test | None = None, ctc_in: Contractor | None 
     batch : int
         The frontier is classified in chunks of this many boxes (whole batches for the
         contractor or test, small enough to stay in cache).
+    executor : concurrent.futures.Executor, optional
+        Pave on these workers (``boundest.parallel``): once the frontier holds ``split`` boxes,
+        it is cut into ``tasks`` contiguous parts and each worker paves its parts to the end
+        with the same batched loop. The parts are disjoint pieces of the frontier, so the
+        merged subpaving has neither duplicates nor holes; it holds exactly the boxes of the
+        in-process paving (the contractors and tests act box by box), in an order set by
+        ``split`` and ``tasks`` only: bit-identical with any number of workers
+        (``Subpaving.sorted`` compares it with the in-process one). Not with ``max_boxes``
+        (a bound on the whole paving).
+    split, tasks : int
+        With an executor: the frontier size at which the work is cut, and into how many tasks
+        (a few per worker or more: the parts differ in size).
+    progress : bool or None
+        With an executor: a progress bar over the tasks (None: only on a terminal).
 
     Returns
     -------
     Subpaving
         Inside boxes proven in the set; every point of the set in ``box`` lies in an inside or
         boundary box. ``stats`` holds ``iterations``, ``processed`` (boxes classified) and
-        ``stopped`` (``"eps"`` or ``"max_boxes"``).
+        ``stopped`` (``"eps"`` or ``"max_boxes"``); with an executor (once the work was cut),
+        also ``parallel``: ``tasks``, ``split_at`` (frontier size), ``head_s`` (paving before the
+        cut), ``map_s`` (the tasks, wall-clock), ``merge_s`` and ``task_s`` (seconds each task
+        spent paving on its worker, ``task_cpu_s`` the CPU seconds).
     """
     if not isinstance(box, Interval) or box.ndim != 1 or box.shape[0] == 0:
         raise ValueError(f"sivia needs a box of shape (n,), got {box!r}")
@@ -188,13 +211,73 @@ def sivia(box: Interval, *, test: Test | None = None, ctc_in: Contractor | None 
         if getattr(ctc_out, "n", n) != n:
             raise ValueError(f"f has {ctc_out.n} variables, the box has dimension {n}")
 
+    frontier = box.reshape(1, n).copy()
+    kw = {"test": test, "ctc_in": ctc_in, "ctc_out": ctc_out, "eps": eps,
+          "keep_outside": keep_outside, "batch": batch}
+    if executor is None:
+        run = _pave(frontier, max_boxes=max_boxes, **kw)
+        return _subpaving([run], n)
+    if max_boxes is not None:
+        raise ValueError("max_boxes bounds the whole paving, which workers paving their own "
+                         "parts cannot enforce; with an executor, bound the work with eps")
+    if split < 1 or tasks < 1:
+        raise ValueError(f"split and tasks must be at least 1, got {split} and {tasks}")
+    t0 = time.perf_counter()
+    head = _pave(frontier, split=max(split, tasks), **kw)
+    if head.frontier.shape[0] == 0:  # decided before the frontier grew large: in-process
+        return _subpaving([head], n)
+    bounds = np.linspace(0, head.frontier.shape[0], tasks + 1).astype(np.intp)
+    parts = [head.frontier[a:b] for a, b in pairwise(bounds) if b > a]
+    t1 = time.perf_counter()
+    work: dict = {}
+    runs = map_chunked(_PavePart(kw), parts, executor, chunk=1, progress=progress,
+                       desc="sivia", stats=work)
+    t2 = time.perf_counter()
+    out = _subpaving([head, *runs], n, head.iterations)
+    out.stats["parallel"] = {"tasks": len(parts), "split_at": head.frontier.shape[0],
+                             "head_s": t1 - t0, "map_s": t2 - t1,
+                             "merge_s": time.perf_counter() - t2, "task_s": work["compute_s"],
+                             "task_cpu_s": work["cpu_s"]}
+    return out
+
+
+@dataclass
+class _Run:
+    """What one paving loop produced (its frontier is non-empty when it stopped to split)."""
+
+    inside: list[Interval]
+    boundary: list[Interval]
+    outside: list[Interval]
+    frontier: Interval
+    iterations: int
+    processed: int
+    stopped: str
+
+
+@dataclass
+class _PavePart:
+    """The paving of one part of the frontier, run on a worker (picklable: a dataclass)."""
+
+    kw: dict
+
+    def __call__(self, frontier: Interval) -> _Run:
+        return _pave(frontier, **self.kw)
+
+
+def _pave(frontier: Interval, *, test, ctc_in, ctc_out, eps: float, keep_outside: bool,
+          batch: int, max_boxes: int | None = None, split: int | None = None) -> _Run:
+    """SIVIA's loop from ``frontier``: classify the whole frontier (in chunks of ``batch``),
+    keep the decided and the small boxes, bisect the others; stop when nothing is left, before
+    exceeding ``max_boxes``, or (``split``) once the frontier holds at least ``split`` boxes."""
+    n = frontier.shape[1]
     inside: list[Interval] = []
     boundary: list[Interval] = []
     outside: list[Interval] = []
-    frontier = box.reshape(1, n).copy()
     done = processed = iterations = 0
     stopped = "eps"
     while frontier.shape[0]:
+        if split is not None and frontier.shape[0] >= split:
+            return _Run(inside, boundary, outside, frontier, iterations, processed, stopped)
         iterations += 1
         processed += frontier.shape[0]
         bigs = []
@@ -215,9 +298,19 @@ def sivia(box: Interval, *, test: Test | None = None, ctc_in: Contractor | None 
         left, right = big.bisect()
         frontier = Interval._new(np.concatenate([left.lo, right.lo]),
                                  np.concatenate([left.hi, right.hi]))
-    ins, bnd = _cat(inside, n), _cat(boundary, n)
+    return _Run(inside, boundary, outside, frontier[:0], iterations, processed, stopped)
+
+
+def _subpaving(runs: list[_Run], n: int, head_iterations: int = 0) -> Subpaving:
+    """The subpaving of the runs, their boxes in the order of the runs (inside, then
+    boundary)."""
+    ins = _cat([b for r in runs for b in r.inside], n)
+    bnd = _cat([b for r in runs for b in r.boundary], n)
     labels = np.zeros(ins.shape[0] + bnd.shape[0], dtype=bool)
     labels[:ins.shape[0]] = True
-    out = Subpaving(_cat([ins, bnd], n), labels, _cat(outside, n))
-    out.stats = {"iterations": iterations, "processed": processed, "stopped": stopped}
+    out = Subpaving(_cat([ins, bnd], n), labels, _cat([b for r in runs for b in r.outside], n))
+    tail = max((r.iterations for r in runs[1:]), default=0)
+    stopped = "max_boxes" if any(r.stopped == "max_boxes" for r in runs) else "eps"
+    out.stats = {"iterations": (head_iterations + tail) if len(runs) > 1 else runs[0].iterations,
+                 "processed": sum(r.processed for r in runs), "stopped": stopped}
     return out

@@ -259,6 +259,21 @@ class Subpaving:
         return cls(Interval._new(np.empty((0, dim)), np.empty((0, dim))),
                    np.zeros(0, dtype=bool))
 
+    def sorted(self) -> Subpaving:
+        """The same subpaving with its boxes in a canonical order (inside boxes first, then by
+        lower then upper bounds, dimension 0 first; the outside boxes likewise): two subpavings
+        hold the same labelled boxes exactly when their ``sorted()`` arrays are equal."""
+        def order(b: Interval, first: NDArray | None = None) -> NDArray[np.intp]:
+            keys = [b.hi[:, d] for d in range(b.shape[1] - 1, -1, -1)]
+            keys += [b.lo[:, d] for d in range(b.shape[1] - 1, -1, -1)]
+            return np.lexsort(keys + ([first] if first is not None else []))
+
+        i = order(self.boxes, ~self.inside)
+        j = order(self.outside)
+        out = Subpaving(self.boxes[i], self.inside[i], self.outside[j])
+        out.stats = dict(self.stats)
+        return out
+
     # -- views ----------------------------------------------------------------------------------
     def __len__(self) -> int:
         return self.boxes.shape[0]

@@ -1,0 +1,130 @@
+"""``boundest run pool --monte-carlo N [--scheduler ADDRESS | --workers K]``: the Monte Carlo
+check of the pool observer's claimed probability (:mod:`boundest.scenarios.pool_mc`), its
+table, strict JSON and figure."""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+from collections.abc import Iterator
+from concurrent.futures import Executor, ProcessPoolExecutor
+from pathlib import Path
+
+import numpy as np
+
+from . import pyplot, save_figure, write_json
+
+
+@contextlib.contextmanager
+def executor_of(args: argparse.Namespace) -> Iterator[Executor | None]:
+    """The executor ``--scheduler``/``--workers`` ask for (None: in this process)."""
+    if args.scheduler and args.workers:
+        raise ValueError("give either --scheduler ADDRESS or --workers K, not both")
+    if args.workers is not None and args.workers < 1:
+        raise ValueError(f"--workers must be at least 1, got {args.workers}")
+    if args.scheduler:
+        from ..parallel import client_executor
+
+        try:
+            ex = client_executor(args.scheduler)
+        except RuntimeError as exc:  # Dask distributed is not installed: one sentence
+            raise ValueError(str(exc)) from None
+        try:
+            yield ex
+        finally:
+            ex._client.close()
+    elif args.workers:
+        with ProcessPoolExecutor(args.workers) as ex:
+            yield ex
+    else:
+        yield None
+
+
+def table_rows(mc, rows: int = 12) -> list[dict]:
+    """``rows`` steps at regular times: frequency, its 95 % interval, the claimed bound."""
+    lo, hi = mc.ci()
+    freq = mc.frequency()
+    ks = np.unique(np.rint(np.linspace(0, mc.t.size - 1, rows)).astype(int))
+    return [{"k": int(k), "t": float(mc.t[k]), "frequency": float(freq[k]),
+             "ci95_lo": float(lo[k]), "ci95_hi": float(hi[k]),
+             "window_probability": float(mc.window_probability[k]),
+             "above_bound": bool(freq[k] >= mc.window_probability[k])} for k in ks]
+
+
+def format_table(rows: list[dict]) -> str:
+    head = (f"{'k':>4} {'t (s)':>7} {'frequency':>9} {'95% interval':>19} {'claimed P':>9} "
+            f"{'above':>5}")
+    return "\n".join([head] + [
+        f"{r['k']:>4} {r['t']:>7.2f} {r['frequency']:>9.4f} "
+        f"[{r['ci95_lo']:.4f}, {r['ci95_hi']:.4f}] {r['window_probability']:>9.4f} "
+        f"{'yes' if r['above_bound'] else 'NO':>5}" for r in rows])
+
+
+def run_monte_carlo(args: argparse.Namespace) -> int:
+    """Run the Monte Carlo of ``args.monte_carlo`` missions; print, write JSON and the figure.
+    Returns 0 when the frequency is at or above the claimed bound at every step, else 1."""
+    from ..scenarios.pool_mc import pool_monte_carlo
+
+    if args.monte_carlo < 1:
+        raise ValueError(f"--monte-carlo needs at least 1 mission, got {args.monte_carlo}")
+    if args.data:
+        raise ValueError("--monte-carlo simulates missions of the embedded setup; it does not "
+                         "read --data")
+    with executor_of(args) as ex:
+        where = (f"on the cluster at {args.scheduler}" if args.scheduler else
+                 f"on {args.workers} local worker processes" if args.workers else "in-process")
+        print(f"pool Monte Carlo: {args.monte_carlo} simulated missions (outlier probability "
+              f"0.05 per ping), q = {args.q}, m = {args.m}, chunks of {args.mc_chunk} "
+              f"missions, {where}")
+        mc = pool_monte_carlo(args.monte_carlo, args.q, args.m, seed=args.mc_seed,
+                              chunk=args.mc_chunk, executor=ex, progress=None,
+                              sweeps=0 if args.sweeps is None else args.sweeps,
+                              carry=not args.window_only)
+    freq = mc.frequency()
+    below = int(np.count_nonzero(freq < mc.window_probability))
+    hi = mc.ci()[1]
+    print(f"time: {mc.time_s:.1f} s ({mc.solve_s:.1f} s in the observer, summed over tasks; "
+          f"{mc.empty_steps} empty steps in all)")
+    print(f"containment: min {freq.min():.4f} at k = {int(freq.argmin())}; frequency below the "
+          f"claimed bound at {below} of {freq.size} steps; 95 % interval entirely below it at "
+          f"{int(np.count_nonzero(hi < mc.window_probability))}")
+    viol = int((mc.windows_ok - mc.inside_when_ok).sum())
+    print(f"guarantee (every window so far held at most q outliers => x_k in X_k): "
+          f"{viol} violations")
+    rows = table_rows(mc)
+    table = format_table(rows)
+    print(table)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "pool_monte_carlo.txt").write_text(
+        f"# boundest run pool --monte-carlo {args.monte_carlo}, q = {args.q}, m = {args.m}\n"
+        f"# frequency of x_k in X_k, its 95 % Wilson interval, the claimed one-window P\n"
+        f"{table}\n")
+    print(f"wrote {out / 'pool_monte_carlo.txt'}")
+    plt = pyplot()
+    from ..plot.monte_carlo import plot_containment
+
+    fig, ax = plt.subplots(figsize=(9, 5))
+    plot_containment(mc, ax=ax)
+    ax.set_title(f"pool robot: does X_k contain the truth? {mc.missions} simulated missions, "
+                 f"q = {mc.q}, m = {mc.m}", fontsize=10)
+    save_figure(fig, args.out, "pool_monte_carlo")
+    if args.json:
+        write_json(mc.to_json() | {"table": rows}, args.json)
+    return 0 if below == 0 else 1
+
+
+def add_options(p: argparse.ArgumentParser) -> None:
+    """The Monte Carlo options of ``boundest run pool``."""
+    p.add_argument("--monte-carlo", type=int, metavar="N",
+                   help="instead of the embedded mission: simulate N missions with random "
+                   "outliers and compare, per step, how often X_k contains the truth with the "
+                   "claimed probability (figure, table, --json)")
+    p.add_argument("--scheduler", metavar="ADDRESS", help="with --monte-carlo: run on the Dask "
+                   "cluster at this scheduler address (pip install 'boundest[distributed]')")
+    p.add_argument("--workers", type=int, metavar="K",
+                   help="with --monte-carlo: run on K local worker processes")
+    p.add_argument("--mc-chunk", type=int, default=250, metavar="C",
+                   help="with --monte-carlo: missions per task (default 250)")
+    p.add_argument("--mc-seed", type=int, default=0, help="with --monte-carlo: seed of the "
+                   "first mission (default 0)")
