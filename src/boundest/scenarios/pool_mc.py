@@ -74,12 +74,12 @@ class _Counts:
 
 
 def _chunk_counts(seed_size: tuple[int, int], q: int, m: int, p_outlier: float,
-                  n_samples: int) -> _Counts:
+                  n_samples: int, sweeps: int = 0, carry: bool = True) -> _Counts:
     """Simulate the missions of one chunk, run the observer on them, count (on a worker)."""
     seed, size = seed_size
     sim, truth = simulate_pool(seed=seed, n_missions=size, p_outlier=p_outlier,
                                n_samples=n_samples)
-    res = solve_pool(sim, q=q, m=m)
+    res = solve_pool(sim, q=q, m=m, sweeps=sweeps, carry=carry)
     hit = ((res.boxes.lo <= truth.states) & (truth.states <= res.boxes.hi)).all(-1)
     ok = _windows_ok(truth.outlier, m, q)
     return _Counts(hit.sum(0), ok.sum(0), (hit & ok).sum(0), int(res.empty.sum()),
