@@ -11,7 +11,7 @@ from ..expr.model import Model
 from ..expr.nodes import Constraint
 from ..expr.tape import Tape, compile_model
 from ..interval import Interval
-from .engine import EMPTY, RUNNING, propagate_kernel
+from .engine import EMPTY, RUNNING, family_flags, propagate_kernel
 
 __all__ = ["Propagation", "propagate", "slot_users"]
 
@@ -120,19 +120,20 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
             hi[s] = min(hi[s], float(dom.hi))
     budget = 10_000 * max(tape.n_nodes, 1) if max_evaluations is None else max_evaluations
     ptr, adj = slot_users(tape)
+    families = family_flags(tape.op)
     n = tape.n_nodes
     dirty = np.ones(n, dtype=np.bool_)
     state = np.array([0, n, RUNNING, 0, 1], dtype=np.int64)
     # a zero-budget call compiles (first use) or loads the kernel outside the timed part
     propagate_kernel(tape.op, tape.out, tape.a, tape.b, tape.param, lo, hi, ptr, adj, dirty,
-                     state.copy(), rel_eps, 0, window)
+                     state.copy(), rel_eps, 0, window, *families)
     t0 = time.perf_counter()
     status = EMPTY if np.isnan(lo).any() or (lo > hi).any() else RUNNING
     bar = None
     while status == RUNNING and state[3] < budget and n > 0:
         status = propagate_kernel(tape.op, tape.out, tape.a, tape.b, tape.param, lo, hi, ptr,
                                   adj, dirty, state, rel_eps, min(chunk, budget - state[3]),
-                                  window)
+                                  window, *families)
         if bar is None and status == RUNNING and (progress or (
                 progress is None and time.perf_counter() - t0 > 2.0)):
             from tqdm import tqdm
