@@ -95,7 +95,8 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
     domains : dict, optional
         Domains overriding the model's initial ones (by variable name).
     progress : bool, optional
-        Show a progress bar (default: only when the run lasts more than 2 s).
+        Show a progress counter of node revisions and dirty nodes (default: only when the run
+        lasts more than 2 s).
     chunk : int
         Node revisions per call of the compiled kernel (between progress updates).
     window : int
@@ -138,11 +139,12 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
                 progress is None and time.perf_counter() - t0 > 2.0)):
             from tqdm import tqdm
 
-            bar = tqdm(total=budget, unit="rev", desc="propagating", leave=False)
+            # no total: the budget is a cap, not a forecast of the revisions to the fixed
+            # point; the bar counts revisions and shows how many nodes are still dirty
+            bar = tqdm(unit="rev", unit_scale=True, desc="propagating", leave=False)
         if bar is not None:
-            bar.n = int(state[3])
+            bar.update(int(state[3]) - bar.n)
             bar.set_postfix(dirty=int(state[1]))
-            bar.refresh()
     if bar is not None:
         bar.close()
     elapsed = time.perf_counter() - t0
