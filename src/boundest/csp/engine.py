@@ -66,8 +66,8 @@ _b_sin, _b_cos, _b_tan, _b_asin, _b_acos = (tr._sin_rev.scalar, tr._cos_rev.scal
 #: (+, -, *, /, sqr, sqrt, neg) is always there.
 FAMILIES: dict[str, tuple[int, ...]] = {
     "piecewise": (ABS, SIGN, FLOOR, CEIL, MIN, MAX),
-    "power": (POWN, POW),
-    "explog": (EXP, LOG, SINH, COSH, TANH, ATAN, ATAN2),
+    "pown": (POWN,),
+    "explog": (EXP, LOG, SINH, COSH, TANH, ATAN, ATAN2, POW),
     "trig": (SIN, COS, TAN, ASIN, ACOS),
 }
 
@@ -117,26 +117,25 @@ def _revise_piecewise(code, zl, zh, xl, xh, yl, yh):
 
 
 @nb.njit(cache=True, error_model="numpy")
-def _revise_power(code, zl, zh, xl, xh, yl, yh, p, buf):
-    """HC4-revise of ``pown`` (integer exponent ``p``) and ``pow`` nodes."""
-    o0, o1, o2, o3 = buf[0:1], buf[1:2], buf[2:3], buf[3:4]
-    if code == POWN:
-        _f_pown(xl, xh, np.int64(p), o0, o1)
-        zl, zh = _cap(zl, zh, buf[0], buf[1])
-        _b_pown(zl, zh, xl, xh, np.int64(p), o0, o1)
-        xl, xh = buf[0], buf[1]
-    elif code == POW:
-        _f_pow(xl, xh, yl, yh, o0, o1)
-        zl, zh = _cap(zl, zh, buf[0], buf[1])
-        _b_pow(zl, zh, xl, xh, yl, yh, o0, o1, o2, o3)
-        xl, xh, yl, yh = buf[0], buf[1], buf[2], buf[3]
-    return zl, zh, xl, xh, yl, yh
+def _revise_pown(zl, zh, xl, xh, p, buf):
+    """HC4-revise of a ``pown`` node (integer exponent ``p``)."""
+    o0, o1 = buf[0:1], buf[1:2]
+    _f_pown(xl, xh, np.int64(p), o0, o1)
+    zl, zh = _cap(zl, zh, buf[0], buf[1])
+    _b_pown(zl, zh, xl, xh, np.int64(p), o0, o1)
+    return zl, zh, buf[0], buf[1]
 
 
 @nb.njit(cache=True, error_model="numpy")
 def _revise_explog(code, zl, zh, xl, xh, yl, yh, buf):
-    """HC4-revise of the exponential family (exp, log, sinh, cosh, tanh, atan, atan2)."""
+    """HC4-revise of the exponential family (exp, log, sinh, cosh, tanh, atan, atan2, and the
+    real power ``pow(x, y) = exp(y log x)``)."""
     o0, o1, o2, o3 = buf[0:1], buf[1:2], buf[2:3], buf[3:4]
+    if code == POW:
+        _f_pow(xl, xh, yl, yh, o0, o1)
+        zl, zh = _cap(zl, zh, buf[0], buf[1])
+        _b_pow(zl, zh, xl, xh, yl, yh, o0, o1, o2, o3)
+        return zl, zh, buf[0], buf[1], buf[2], buf[3]
     if code == ATAN2:
         _f_atan2(xl, xh, yl, yh, o0, o1)
         zl, zh = _cap(zl, zh, buf[0], buf[1])
@@ -205,11 +204,11 @@ def _revise_trig(code, zl, zh, xl, xh, yl, yh, buf):
 
 
 @nb.njit(cache=True, error_model="numpy")
-def _revise(code, zl, zh, xl, xh, yl, yh, p, buf, piecewise, power, explog, trig):
+def _revise(code, zl, zh, xl, xh, yl, yh, p, buf, piecewise, pown, explog, trig):
     """HC4-revise of node ``z = f(x, y)``: ``z ∩= f(x, y)``, then ``(x, y) = f_rev(z, x, y)``.
 
     Returns the new ``(zl, zh, xl, xh, yl, yh)``. The basic arithmetic is inline; each other
-    family is one kernel, compiled in only when its argument (``piecewise``, ``power``,
+    family is one kernel, compiled in only when its argument (``piecewise``, ``pown``,
     ``explog``, ``trig``) is not ``None`` (Numba prunes ``x is not None`` on a ``None``
     argument before typing). A node of a family left out is not contracted, which is sound.
     """
@@ -235,11 +234,12 @@ def _revise(code, zl, zh, xl, xh, yl, yh, p, buf, piecewise, power, explog, trig
         zl, zh = _cap(zl, zh, -xh, -xl)
         xl, xh = al._neg_rev_all(zl, zh, xl, xh)
     else:
-        if power is not None and code in (POWN, POW):
-            return _revise_power(code, zl, zh, xl, xh, yl, yh, p, buf)
+        if pown is not None and code == POWN:
+            zl, zh, xl, xh = _revise_pown(zl, zh, xl, xh, p, buf)
+            return zl, zh, xl, xh, yl, yh
         if piecewise is not None and code in (ABS, SIGN, FLOOR, CEIL, MIN, MAX):
             return _revise_piecewise(code, zl, zh, xl, xh, yl, yh)
-        if explog is not None and code in (EXP, LOG, SINH, COSH, TANH, ATAN, ATAN2):
+        if explog is not None and code in (EXP, LOG, SINH, COSH, TANH, ATAN, ATAN2, POW):
             return _revise_explog(code, zl, zh, xl, xh, yl, yh, buf)
         if trig is not None:
             return _revise_trig(code, zl, zh, xl, xh, yl, yh, buf)
@@ -275,7 +275,7 @@ def _update(s, nl, nh, lo, hi, rel_eps):
 
 @nb.njit(cache=True, inline="always", error_model="numpy")
 def _revise_node(i, op, out, a, b, param, lo, hi, ptr, adj, dirty, pending, window, rel_eps,
-                 buf, changed, piecewise, power, explog, trig):
+                 buf, changed, piecewise, pown, explog, trig):
     """Revise node ``i`` and mark the nodes whose slots it shrank significantly. Returns the
     number of nodes newly marked dirty, or -1 when a domain became empty."""
     o, ia, ib = out[i], a[i], b[i]
@@ -284,7 +284,7 @@ def _revise_node(i, op, out, a, b, param, lo, hi, ptr, adj, dirty, pending, wind
     xl, xh = lo[ia], hi[ia]
     yl, yh = (lo[ib], hi[ib]) if ib >= 0 else (0.0, 0.0)
     zl, zh, xl, xh, yl, yh = _revise(op[i], lo[o], hi[o], xl, xh, yl, yh, param[i], buf,
-                                       piecewise, power, explog, trig)
+                                       piecewise, pown, explog, trig)
     # when o aliases an argument, each update is still a sound intersection
     nch = 0
     r = _update(o, zl, zh, lo, hi, rel_eps)
@@ -320,7 +320,7 @@ def _revise_node(i, op, out, a, b, param, lo, hi, ptr, adj, dirty, pending, wind
 
 @nb.njit(cache=True, error_model="numpy")
 def propagate_kernel(op, out, a, b, param, lo, hi, ptr, adj, dirty, state, rel_eps, max_evals,
-                     window, piecewise=None, power=None, explog=None, trig=None):
+                     window, piecewise=None, pown=None, explog=None, trig=None):
     """Revise dirty nodes window by window, for at most about ``max_evals`` node revisions.
 
     The tape is cut into windows of ``window`` consecutive nodes. A pass visits the windows in
@@ -364,7 +364,7 @@ def propagate_kernel(op, out, a, b, param, lo, hi, ptr, adj, dirty, state, rel_e
                     count -= 1
                     evals += 1
                     r = _revise_node(i, op, out, a, b, param, lo, hi, ptr, adj, dirty, pending,
-                                     window, rel_eps, buf, changed, piecewise, power,
+                                     window, rel_eps, buf, changed, piecewise, pown,
                                      explog, trig)
                     if r < 0:
                         status = EMPTY
