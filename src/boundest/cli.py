@@ -17,8 +17,8 @@ from .commands import SCENARIOS, pyplot, save_figure, write_json
 
 #: Measured empty-cache compile time of each command on the project's 2-core machine
 #: (``benchmarks/bench_startup.py``), printed when a run starts compiling.
-COMPILE_ESTIMATE_S = {"satellite": 15, "jaulin2001": 15, "range-only": 25,
-                      "drifting-clock": 20, "auv": 45, "pool": 25, "solve": 15, "demo": 10}
+COMPILE_ESTIMATE_S = {"satellite": 12, "jaulin2001": 11, "range-only": 23,
+                      "drifting-clock": 12, "auv": 20, "pool": 27, "solve": 13, "demo": 5}
 
 
 def _demo(args: argparse.Namespace) -> int:
