@@ -100,7 +100,8 @@ def bench_command(name: str, cmd: list[str], repeat: int, timeout: float) -> dic
         n_files = sum(1 for _ in (Path(tmp) / "numba-cache").rglob("*.nbc"))
         size = sum(f.stat().st_size for f in (Path(tmp) / "numba-cache").rglob("*.nb*"))
     ws = [w["wall_s"] for w in warm]
-    return {"command": "boundest " + " ".join(cmd), "cold": cold, "warm": warm,
+    shown = " ".join(cmd).replace(f"{ROOT}{os.sep}", "")
+    return {"command": f"boundest {shown}", "cold": cold, "warm": warm,
             "warm_median_s": statistics.median(ws) if ws else None,
             "warm_min_s": min(ws) if ws else None,
             "cache_files_nbc": n_files, "cache_bytes": size}
