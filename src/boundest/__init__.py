@@ -5,57 +5,71 @@ functions that accept intervals and expressions alike (``sin(Interval)`` is an e
 ``sin(Var)`` an expression node), variables and models, contractors and propagation. ``abs``,
 ``min``, ``max`` and ``pow`` are reachable as ``boundest.abs`` etc. but are not exported by
 ``from boundest import *``.
+
+The names are loaded on first access (PEP 562), so that ``import boundest.cli`` and
+``boundest --help`` load neither NumPy nor Numba.
 """
 
-from .csp import Arc, BetaResult, Propagation, TreeSCSP, beta_tuning, propagate  # noqa: F401
-from .ctc import (  # noqa: F401
-    Contractor,
-    CtcFwdBwd,
-    CtcQInter,
-    Fixpoint,
-    FunctionContractor,
-    Inflate,
-    Sequence,
-    Union,
-)
-from .estimation import ChainEstimate, DiscreteSystem, cse, ncse, rcse  # noqa: F401
-from .expr import (  # noqa: F401
-    Constraint,
-    Model,
-    ModelSyntaxError,
-    Var,
-    VarFamily,
-    load_model,
-    parse_model,
-)
-from .expr import functions as _functions
-from .interval import *  # noqa: F403
-from .interval import IntervalVector
-from .interval import __all__ as _interval_all
-from .paving import Subpaving, image, separators, sivia  # noqa: F401
-from .tube import (  # noqa: F401
-    ContractorNetwork,
-    CtcDeriv,
-    CtcEval,
-    CtcSlices,
-    NetworkReport,
-    Tube,
-    TubeVector,
-)
+from __future__ import annotations
 
-# the dispatching functions replace the interval-only ones of the same name
-globals().update({name: getattr(_functions, name) for name in _functions.__all__})
-abs, min, max, pow = _functions.abs, _functions.min, _functions.max, _functions.pow
+import importlib
+from typing import Any
 
 __version__ = "0.1.0"
-Box = IntervalVector
 
-__all__ = list(dict.fromkeys([
-    *_interval_all, *_functions.__all__, "Box", "__version__", "BetaResult", "Propagation",
-    "beta_tuning", "propagate", "Contractor", "CtcFwdBwd", "CtcQInter", "Fixpoint",
-    "FunctionContractor", "Inflate", "Sequence", "Union", "Constraint", "Model",
-    "ModelSyntaxError", "Var",
-    "VarFamily", "load_model", "parse_model", "Arc", "TreeSCSP", "ChainEstimate",
-    "DiscreteSystem", "cse", "ncse", "rcse", "Subpaving", "image", "separators", "sivia",
-    "ContractorNetwork", "CtcDeriv", "CtcEval", "CtcSlices", "NetworkReport", "Tube",
-    "TubeVector"]))
+#: name -> submodule that defines it (the interval names and the dispatching elementary
+#: functions are looked up in ``interval`` and ``expr.functions``, see ``__getattr__``)
+_NAMES: dict[str, str] = {
+    **dict.fromkeys(("Arc", "BetaResult", "Propagation", "TreeSCSP", "beta_tuning",
+                     "propagate"), "csp"),
+    **dict.fromkeys(("Contractor", "CtcFwdBwd", "CtcQInter", "Fixpoint", "FunctionContractor",
+                     "Inflate", "Sequence", "Union"), "ctc"),
+    **dict.fromkeys(("ChainEstimate", "DiscreteSystem", "cse", "ncse", "rcse"), "estimation"),
+    **dict.fromkeys(("Constraint", "Model", "ModelSyntaxError", "Var", "VarFamily",
+                     "load_model", "parse_model"), "expr"),
+    **dict.fromkeys(("Subpaving", "image", "separators", "sivia"), "paving"),
+    **dict.fromkeys(("ContractorNetwork", "CtcDeriv", "CtcEval", "CtcSlices", "NetworkReport",
+                     "Tube", "TubeVector"), "tube"),
+    **dict.fromkeys(("abs", "min", "max", "pow"), "expr.functions"),
+    "Box": "interval",
+}
+_ALIASES = {"Box": "IntervalVector"}
+_SUBPACKAGES = ("interval", "expr", "ctc", "csp", "paving", "tube", "estimation", "scenarios",
+                "plot", "commands", "cli")
+
+
+def _all() -> list[str]:
+    from .expr import functions
+    from .interval import __all__ as interval_all
+
+    named = [n for n in _NAMES if n not in ("abs", "min", "max", "pow")]
+    return list(dict.fromkeys([*interval_all, *functions.__all__, "__version__", *named]))
+
+
+def __getattr__(name: str) -> Any:
+    if name == "__all__":
+        value: Any = _all()
+    elif name in _NAMES:
+        module = importlib.import_module(f".{_NAMES[name]}", __name__)
+        value = getattr(module, _ALIASES.get(name, name))
+    elif name in _SUBPACKAGES:
+        value = importlib.import_module(f".{name}", __name__)
+    elif name.startswith("__"):
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    else:
+        # the dispatching functions replace the interval-only ones of the same name
+        from . import interval
+        from .expr import functions
+
+        if name in functions.__all__:
+            value = getattr(functions, name)
+        elif name in interval.__all__:
+            value = getattr(interval, name)
+        else:
+            raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *_all(), "abs", "min", "max", "pow"})

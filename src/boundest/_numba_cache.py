@@ -53,3 +53,34 @@ def drop_stale_numba_cache() -> None:
         stamp.write_text(digest.hexdigest())
     except OSError:  # read-only install: Numba then caches elsewhere or not at all
         pass
+
+
+def announce_compilation(what: str, estimate_s: float | None = None) -> None:
+    """Print one line on standard error when Numba first compiles a kernel in this process.
+
+    Numba reports a compilation (a ``numba:compile`` event) only on a cache miss, so a run
+    that finds every kernel in the on-disk cache prints nothing. Called by the command line
+    before a command runs; ``what`` names the command, ``estimate_s`` is its measured
+    empty-cache compile time on 2 cores (printed as "about N s").
+    """
+    import sys
+
+    from numba.core import event
+
+    class _Notice(event.Listener):
+        def __init__(self) -> None:
+            self.said = False
+
+        def on_start(self, ev: event.Event) -> None:  # noqa: ARG002 - numba's signature
+            if self.said:
+                return
+            self.said = True
+            how_long = (f"about {estimate_s:.0f} s on 2 cores" if estimate_s is not None
+                        else "it may take a minute")
+            print(f"boundest: compiling the Numba kernels {what} uses ({how_long}; once: they "
+                  f"are cached on disk for later runs) ...", file=sys.stderr, flush=True)
+
+        def on_end(self, ev: event.Event) -> None:
+            pass
+
+    event.register("numba:compile", _Notice())

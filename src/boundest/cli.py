@@ -1,17 +1,29 @@
-"""The ``boundest`` command."""
+"""The ``boundest`` command.
+
+Parsing the arguments imports neither NumPy nor Numba: the scenario modules are imported only
+for the scenario named on the command line (``commands.SCENARIOS`` lists them), and each
+command imports the numerical layers when it runs. ``boundest --help`` and an argument error
+therefore return in a few tens of milliseconds.
+"""
 
 from __future__ import annotations
 
 import argparse
+import importlib
 import sys
 
-import numpy as np
-
 from . import __version__
-from .commands import RUNS, pyplot, save_figure, write_json
+from .commands import SCENARIOS, pyplot, save_figure, write_json
+
+#: Measured empty-cache compile time of each command on the project's 2-core machine
+#: (``benchmarks/bench_startup.py``), printed when a run starts compiling.
+COMPILE_ESTIMATE_S = {"satellite": 12, "jaulin2001": 11, "range-only": 23,
+                      "drifting-clock": 12, "auv": 20, "pool": 27, "solve": 13, "demo": 5}
 
 
 def _demo(args: argparse.Namespace) -> int:
+    import numpy as np
+
     plt = pyplot()
 
     from .plot import plot_boxes
@@ -40,29 +52,27 @@ def _demo(args: argparse.Namespace) -> int:
     return 0
 
 
-def _solve(args: argparse.Namespace) -> int:
-    from .csp import propagate
-    from .expr import load_model
-
-    model = load_model(args.file)
-    for key, value in model.options.items():
-        print(f"note: option '{key} {value}' is not used by boundest")
-    res = propagate(model, rel_eps=args.rel_eps)
-    status = "consistent" if res.consistent else "INCONSISTENT (no solution)"
-    print(f"{args.file}: {len(model.domains)} variables, {len(model.constraints)} constraints: "
-          f"{status}; {res.evaluations} node revisions in {res.time_s:.3f} s")
-    width = max((len(n) for n in res.domains), default=0)
-    for name, dom in res.domains.items():
-        text = "[empty]" if bool(dom.is_empty()) else f"[{float(dom.lo)!r}, {float(dom.hi)!r}]"
-        print(f"  {name:<{width}} in {text}")
-    if args.json:
-        write_json({"file": str(args.file), "consistent": res.consistent,
-                    "evaluations": res.evaluations, "time_s": res.time_s,
-                    "domains": res.domains}, args.json)
-    return 0 if res.consistent else 1
+def _scenario_named(argv: list[str] | None) -> str | None:
+    """The scenario of ``boundest run NAME`` in ``argv`` (None: not a run, or no name yet)."""
+    if argv is None:
+        return None
+    words = [a for a in argv if not a.startswith("-")]
+    if len(words) >= 2 and words[0] == "run":
+        return words[1]
+    return None
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(argv: list[str] | None = None) -> argparse.ArgumentParser:
+    """The argument parser of ``boundest``.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments about to be parsed. When they name a scenario (``run NAME ...``), only
+        that scenario's module is imported and registered with its options; the others are
+        listed by name and help only. Without ``argv`` every scenario module is imported.
+    """
+    chosen = _scenario_named(argv)
     parser = argparse.ArgumentParser(
         prog="boundest",
         description="Guaranteed nonlinear state estimation by interval constraint propagation.")
@@ -77,21 +87,27 @@ def build_parser() -> argparse.ArgumentParser:
 
     run = sub.add_parser("run", help="run a seed scenario end to end on its embedded data")
     scen = run.add_subparsers(dest="scenario", required=True)
-    for module in RUNS:
-        module.register(scen)
+    for name, (module, text) in SCENARIOS.items():
+        if argv is None or name == chosen:
+            importlib.import_module(f".commands.{module}", __package__).register(scen)
+        else:  # named for `boundest run --help`; never parsed (the chosen one is registered)
+            scen.add_parser(name, help=text)
 
-    solve = sub.add_parser("solve", help="propagate a model file and print every domain")
-    solve.add_argument("file", help="model in the text format (docs: boundest.expr.parser)")
-    solve.add_argument("--rel-eps", type=float, default=1e-3)
-    solve.add_argument("--json", help="write the domains as JSON to this file "
-                                      "(strict JSON: docs/json.md)")
-    solve.set_defaults(func=_solve)
+    from .commands import solve
+
+    solve.register(sub)
     return parser
 
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``boundest`` console script."""
-    args = build_parser().parse_args(argv)
+    argv = sys.argv[1:] if argv is None else list(argv)
+    args = build_parser(argv).parse_args(argv)
+    from ._numba_cache import announce_compilation
+
+    what = args.scenario if args.command == "run" else args.command
+    label = f"boundest run {what}" if args.command == "run" else f"boundest {what}"
+    announce_compilation(f"'{label}'", COMPILE_ESTIMATE_S.get(what))
     try:
         return args.func(args)
     except (ValueError, OSError) as exc:

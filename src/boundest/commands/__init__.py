@@ -1,6 +1,9 @@
 """One module per `boundest run` scenario: `register(subparsers)` adds it, `run(args)` runs it.
 
-A scenario module imports matplotlib inside ``run`` only, so that ``boundest --help`` stays fast.
+``SCENARIOS`` names them without importing them: the command line imports only the module of the
+scenario it runs, and this package imports neither NumPy nor Numba at import, so that
+``boundest --help`` and argument errors stay fast. A scenario module imports the numerical
+layers and matplotlib inside ``run``.
 """
 
 from __future__ import annotations
@@ -10,9 +13,18 @@ import math
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
-from ..interval import Interval
+#: ``boundest run NAME`` -> (module of this package, one-line help for ``boundest run --help``);
+#: add a scenario by writing its module and listing it here
+SCENARIOS: dict[str, tuple[str, str]] = {
+    "satellite": ("satellite", "Jaulin 2002: satellite localisation as a CSP"),
+    "jaulin2001": ("jaulin2001", "Jaulin et al. 2001: causal and non-causal set estimation"),
+    "range-only": ("range_only", "Rohou et al. 2018: range-only robot with uncertain times"),
+    "drifting-clock": ("drifting_clock", "Rohou et al. 2018: correcting a drifting clock"),
+    "auv": ("auv", "AUV mine survey (Jaulin et al. 2007): localization and SLAM over 60,000 "
+                   "samples"),
+    "pool": ("pool", "pool robot (Jaulin's robust set-membership observer): a recursive "
+                     "q-relaxed observer over sonar pings"),
+}
 
 
 def pyplot() -> Any:
@@ -47,6 +59,18 @@ def jsonable(obj: Any) -> Any:
     empty; arrays of intervals are nested lists); NumPy scalars and arrays become numbers and
     lists, tuples lists. The result always passes ``json.dumps(..., allow_nan=False)``.
     """
+    import numpy as np
+
+    from ..interval import Interval
+
+    return _jsonable(obj, np, Interval)
+
+
+def _jsonable(obj: Any, np: Any, Interval: type) -> Any:
+    """:func:`jsonable` with the modules passed in (imported once per call of ``jsonable``)."""
+    def jsonable(v: Any) -> Any:
+        return _jsonable(v, np, Interval)
+
     if isinstance(obj, dict):
         return {str(k): jsonable(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
@@ -94,9 +118,3 @@ def write_json(data: dict, path: str | None) -> None:
         Path(path).parent.mkdir(parents=True, exist_ok=True)
         Path(path).write_text(text + "\n")
         print(f"wrote {path}")
-
-
-from . import auv, drifting_clock, jaulin2001, pool, range_only, satellite  # noqa: E402
-
-# add a scenario by importing its module above and listing it here
-RUNS = [satellite, jaulin2001, range_only, drifting_clock, auv, pool]

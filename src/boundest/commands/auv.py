@@ -7,12 +7,12 @@ import argparse
 import time
 from pathlib import Path
 
-import numpy as np
-
 from . import pyplot, save_figure, write_json
 
 
 def _summary(res, data) -> None:
+    import numpy as np
+
     w = res.widths()
     print(f"{res.mode}: {'consistent' if res.consistent else 'INCONSISTENT (no solution)'}, "
           f"{res.report.iterations} iteration(s) in {res.time_s:.3f} s "
@@ -45,6 +45,8 @@ def to_json(res, data, npz: Path | None) -> dict:
            "detections": {"k": data.det_k, "mine": data.det_mine, "range": data.det_range},
            "positions_npz": str(npz) if npz is not None else None}
     if npz is not None:
+        import numpy as np
+
         npz.parent.mkdir(parents=True, exist_ok=True)
         np.savez_compressed(npz, t=data.t, lo=res.positions.lo, hi=res.positions.hi)
         print(f"wrote {npz}")
@@ -60,8 +62,7 @@ def run(args: argparse.Namespace) -> int:
     print(f"AUV survey: {data.n} samples over {data.n * data.dt:.0f} s, {data.fix_k.size} GPS "
           f"fixes, {data.det_k.size} detections of {data.n_mines} mines (data: {data.source}; "
           f"read in {time.perf_counter() - start:.2f} s)")
-    print("localization ... (the first run compiles the kernels it uses, about 40 s on 2 cores; "
-          "cached afterwards)", flush=True)
+    print("localization ...", flush=True)
     loc = auv.localize(data)
     _summary(loc, data)
     results = [loc]

@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import argparse
 
-import numpy as np
-
 from . import pyplot, save_figure, write_json
 
 
 def run(args: argparse.Namespace) -> int:
+    import numpy as np
+
     plt = pyplot()
 
     from ..plot.scenarios_tube import plot_clock_distance, plot_clock_drift

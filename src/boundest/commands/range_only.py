@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import argparse
 
-import numpy as np
-
 from . import pyplot, save_figure, write_json
 
 
 def run(args: argparse.Namespace) -> int:
+    import numpy as np
+
     plt = pyplot()
 
     from ..plot.scenarios_tube import plot_range_only_diagonal, plot_range_only_map
@@ -19,8 +19,8 @@ def run(args: argparse.Namespace) -> int:
     n = int(np.ceil((ro.TF - ro.T0) / args.dt))
     print(f"range-only robot (Rohou et al. 2018): {len(meas)} measurements, "
           f"{meas.beacons.shape[0]} beacons, data {meas.source}")
-    print(f"tubes over [{ro.T0:g}, {ro.TF:g}] with dt = {args.dt:g} ({n} slices); the first run "
-          "compiles the tube kernels (cached afterwards)")
+    print(f"tubes over [{ro.T0:g}, {ro.TF:g}] with dt = {args.dt:g} ({n} slices) ...",
+          flush=True)
     res = ro.solve(meas, dt=args.dt, rel_eps=args.rel_eps, max_iter=args.max_iter)
     if res.empty:
         print(f"proven INCONSISTENT after {res.iterations} iterations: no trajectory of the "

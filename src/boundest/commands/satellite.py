@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import argparse
 
-import numpy as np
-
 from . import pyplot, save_figure, write_json
 
 
 def run(args: argparse.Namespace) -> int:
+    import numpy as np
+
     plt = pyplot()
 
     from ..interval import Interval
@@ -19,7 +19,7 @@ def run(args: argparse.Namespace) -> int:
     meas = sat.load(args.data, k_max=args.kmax)
     print(f"satellite (Jaulin 2002): k_max = {meas.k_max}, data {meas.source}")
     print(f"CSP: {7 * (meas.k_max + 1)} constraints over {11 * meas.k_max + 15} variables; "
-          "first run compiles the propagation kernel (cached afterwards)")
+          "propagating ...", flush=True)
     res = sat.solve(meas, rel_eps=args.rel_eps)
     if not res.consistent and args.beta_tuning:
         print("the CSP is empty: the data contradict the model; beta-tuning ...")

@@ -13,16 +13,15 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
+from ..ctc.revise import family_flags
 from ..ctc.revise import revise as _revise
 
-__all__ = ["DONE", "EMPTY", "RUNNING", "propagate_kernel"]
+__all__ = ["DONE", "EMPTY", "RUNNING", "family_flags", "propagate_kernel"]
 
 DONE, RUNNING, EMPTY = 0, 1, 2
 #: A window that has not settled after this many local sweeps hands its remaining dirty nodes
 #: to the next pass (a safeguard against slowly converging cycles; it never loses soundness).
 _LOCAL_SWEEPS = 64
-
-
 @nb.njit(cache=True, inline="always", error_model="numpy")
 def _significant(ol, oh, nl, nh, rel_eps):
     """Whether ``[ol, oh] -> [nl, nh]`` is a shrink worth propagating."""
@@ -52,7 +51,7 @@ def _update(s, nl, nh, lo, hi, rel_eps):
 
 @nb.njit(cache=True, inline="always", error_model="numpy")
 def _revise_node(i, op, out, a, b, param, lo, hi, ptr, adj, dirty, pending, window, rel_eps,
-                 buf, changed):
+                 buf, changed, piecewise, pown, explog, trig):
     """Revise node ``i`` and mark the nodes whose slots it shrank significantly. Returns the
     number of nodes newly marked dirty, or -1 when a domain became empty."""
     o, ia, ib = out[i], a[i], b[i]
@@ -60,7 +59,8 @@ def _revise_node(i, op, out, a, b, param, lo, hi, ptr, adj, dirty, pending, wind
     again = (o == ia) | (o == ib) | (ia == ib)
     xl, xh = lo[ia], hi[ia]
     yl, yh = (lo[ib], hi[ib]) if ib >= 0 else (0.0, 0.0)
-    zl, zh, xl, xh, yl, yh = _revise(op[i], lo[o], hi[o], xl, xh, yl, yh, param[i], buf)
+    zl, zh, xl, xh, yl, yh = _revise(op[i], lo[o], hi[o], xl, xh, yl, yh, param[i], buf,
+                                       piecewise, pown, explog, trig)
     # when o aliases an argument, each update is still a sound intersection
     nch = 0
     r = _update(o, zl, zh, lo, hi, rel_eps)
@@ -96,7 +96,7 @@ def _revise_node(i, op, out, a, b, param, lo, hi, ptr, adj, dirty, pending, wind
 
 @nb.njit(cache=True, error_model="numpy")
 def propagate_kernel(op, out, a, b, param, lo, hi, ptr, adj, dirty, state, rel_eps, max_evals,
-                     window):
+                     window, piecewise=None, pown=None, explog=None, trig=None):
     """Revise dirty nodes window by window, for at most about ``max_evals`` node revisions.
 
     The tape is cut into windows of ``window`` consecutive nodes. A pass visits the windows in
@@ -140,7 +140,8 @@ def propagate_kernel(op, out, a, b, param, lo, hi, ptr, adj, dirty, state, rel_e
                     count -= 1
                     evals += 1
                     r = _revise_node(i, op, out, a, b, param, lo, hi, ptr, adj, dirty, pending,
-                                     window, rel_eps, buf, changed)
+                                     window, rel_eps, buf, changed, piecewise, pown,
+                                     explog, trig)
                     if r < 0:
                         status = EMPTY
                         break

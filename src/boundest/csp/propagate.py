@@ -11,7 +11,7 @@ from ..expr.model import Model
 from ..expr.nodes import Constraint
 from ..expr.tape import Tape, compile_model
 from ..interval import Interval
-from .engine import EMPTY, RUNNING, propagate_kernel
+from .engine import EMPTY, RUNNING, family_flags, propagate_kernel
 
 __all__ = ["Propagation", "propagate", "slot_users"]
 
@@ -95,7 +95,8 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
     domains : dict, optional
         Domains overriding the model's initial ones (by variable name).
     progress : bool, optional
-        Show a progress bar (default: only when the run lasts more than 2 s).
+        Show a progress counter of node revisions and dirty nodes (default: only when the run
+        lasts more than 2 s).
     chunk : int
         Node revisions per call of the compiled kernel (between progress updates).
     window : int
@@ -120,28 +121,30 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
             hi[s] = min(hi[s], float(dom.hi))
     budget = 10_000 * max(tape.n_nodes, 1) if max_evaluations is None else max_evaluations
     ptr, adj = slot_users(tape)
+    families = family_flags(tape.op)
     n = tape.n_nodes
     dirty = np.ones(n, dtype=np.bool_)
     state = np.array([0, n, RUNNING, 0, 1], dtype=np.int64)
     # a zero-budget call compiles (first use) or loads the kernel outside the timed part
     propagate_kernel(tape.op, tape.out, tape.a, tape.b, tape.param, lo, hi, ptr, adj, dirty,
-                     state.copy(), rel_eps, 0, window)
+                     state.copy(), rel_eps, 0, window, *families)
     t0 = time.perf_counter()
     status = EMPTY if np.isnan(lo).any() or (lo > hi).any() else RUNNING
     bar = None
     while status == RUNNING and state[3] < budget and n > 0:
         status = propagate_kernel(tape.op, tape.out, tape.a, tape.b, tape.param, lo, hi, ptr,
                                   adj, dirty, state, rel_eps, min(chunk, budget - state[3]),
-                                  window)
+                                  window, *families)
         if bar is None and status == RUNNING and (progress or (
                 progress is None and time.perf_counter() - t0 > 2.0)):
             from tqdm import tqdm
 
-            bar = tqdm(total=budget, unit="rev", desc="propagating", leave=False)
+            # no total: the budget is a cap, not a forecast of the revisions to the fixed
+            # point; the bar counts revisions and shows how many nodes are still dirty
+            bar = tqdm(unit="rev", unit_scale=True, desc="propagating", leave=False)
         if bar is not None:
-            bar.n = int(state[3])
+            bar.update(int(state[3]) - bar.n)
             bar.set_postfix(dirty=int(state[1]))
-            bar.refresh()
     if bar is not None:
         bar.close()
     elapsed = time.perf_counter() - t0

@@ -69,7 +69,7 @@ from ..interval import arith as ar
 from ..interval import trig as tr
 from .base import Contractor
 from .obstacles import ObstacleMap
-from .revise import hc4_pass
+from .revise import family_flags, hc4_pass
 
 __all__ = ["CtcRayCast", "RayTapes", "raycast_box"]
 
@@ -80,7 +80,8 @@ class RayTapes(NamedTuple):
     """The obstacles' constraint tapes packed for the compiled kernel (obstacle ``o``: nodes
     ``node_ptr[o]:node_ptr[o+1]``, slots ``slot_ptr[o]:slot_ptr[o+1]`` with initial domains
     ``lo0``/``hi0``, and the slots of ``x, y, beta, d`` at ``var_slot[o]``, relative to its
-    first slot), with the map's segments ``(ns, 4)``, centres ``(nc, 2)`` and radii."""
+    first slot), with the map's segments ``(ns, 4)``, centres ``(nc, 2)`` and radii, and the op
+    families the tapes use (:func:`boundest.ctc.revise.family_flags`)."""
 
     op: np.ndarray
     out: np.ndarray
@@ -95,6 +96,10 @@ class RayTapes(NamedTuple):
     segments: np.ndarray
     centers: np.ndarray
     radii: np.ndarray
+    piecewise: bool | None
+    pown: bool | None
+    explog: bool | None
+    trig: bool | None
 
 
 def pack_tapes(obstacles: ObstacleMap) -> RayTapes:
@@ -112,12 +117,13 @@ def pack_tapes(obstacles: ObstacleMap) -> RayTapes:
     var_slot = np.array([[t.slot_of[v] for v in _VARS] for t in tapes],
                         dtype=np.int64).reshape(-1, 4)
     # int32 codes and slots, as the engine's tapes: one compiled revise serves both
-    return RayTapes(cat("op", np.int32), cat("out", np.int32), cat("a", np.int32),
+    op = cat("op", np.int32)
+    return RayTapes(op, cat("out", np.int32), cat("a", np.int32),
                     cat("b", np.int32), cat("param", np.float64), node_ptr, cat("lo", np.float64),
                     cat("hi", np.float64), slot_ptr, var_slot,
                     np.ascontiguousarray(obstacles.segments.reshape(-1, 4), dtype=np.float64),
                     np.ascontiguousarray(obstacles.centers, dtype=np.float64).reshape(-1, 2),
-                    np.ascontiguousarray(obstacles.radii, dtype=np.float64))
+                    np.ascontiguousarray(obstacles.radii, dtype=np.float64), *family_flags(op))
 
 
 class CtcRayCast(Contractor):
@@ -259,10 +265,12 @@ def nearest_bound(px_l, px_h, py_l, py_h, b_l, b_h, segments, centers, radii, bu
 
 @_njit
 def raycast_box(box_lo, box_hi, passes, parts, op, out, a, b, param, node_ptr, lo0, hi0,
-                slot_ptr, var_slot, segments, centers, radii, slo, shi, buf):
+                slot_ptr, var_slot, segments, centers, radii, piecewise, pown, explog, trig, slo,
+                shi, buf):
     """Contract one box ``(x, y, beta, d)`` in place (``parts``: 1 = (a), 2 = (b), 3 = both,
-    ``passes`` times at most). ``slo``/``shi``: scratch of at least ``lo0.size`` floats,
-    ``buf``: 4. Returns False when the box is empty (its bounds are then NaN)."""
+    ``passes`` times at most; the tapes and the family flags: :class:`RayTapes`).
+    ``slo``/``shi``: scratch of at least ``lo0.size`` floats, ``buf``: 4. Returns False when
+    the box is empty (its bounds are then NaN)."""
     for _ in range(passes):
         before = 0.0
         for j in range(4):
@@ -283,7 +291,7 @@ def raycast_box(box_lo, box_hi, passes, parts, op, out, a, b, param, node_ptr, l
                     ok = ok and sl[v] <= sh[v]
                 n0, n1 = node_ptr[o], node_ptr[o + 1]
                 if ok and hc4_pass(op[n0:n1], out[n0:n1], a[n0:n1], b[n0:n1], param[n0:n1],
-                                   sl, sh, buf):
+                                   sl, sh, buf, piecewise, pown, explog, trig):
                     for j in range(4):
                         v = var_slot[o, j]
                         hull_lo[j] = min(hull_lo[j], sl[v])
@@ -322,7 +330,7 @@ def _nearest_bounds(lo, hi, segments, centers, radii):
 
 @_njit
 def _raycast_boxes(lo, hi, passes, parts, op, out, a, b, param, node_ptr, lo0, hi0, slot_ptr,
-                   var_slot, segments, centers, radii):
+                   var_slot, segments, centers, radii, piecewise, pown, explog, trig):
     slo, shi, buf = np.empty(lo0.size), np.empty(lo0.size), np.empty(4)
     for i in range(lo.shape[0]):
         empty = False
@@ -330,7 +338,7 @@ def _raycast_boxes(lo, hi, passes, parts, op, out, a, b, param, node_ptr, lo0, h
             empty = empty or not lo[i, j] <= hi[i, j]
         if empty or not raycast_box(lo[i], hi[i], passes, parts, op, out, a, b, param,
                                     node_ptr, lo0, hi0, slot_ptr, var_slot, segments, centers,
-                                    radii, slo, shi, buf):
+                                    radii, piecewise, pown, explog, trig, slo, shi, buf):
             lo[i, :] = np.nan
             hi[i, :] = np.nan
 

@@ -3,7 +3,9 @@
 The scalar kernels that the propagation engine (:mod:`boundest.csp.engine`) and compiled
 contractors (:class:`boundest.ctc.CtcRayCast`) share: ``revise`` contracts the three domains of
 one node ``z = f(x, y)`` (``z ∩= f(x, y)``, then ``(x, y) = f_rev(z, x, y)``), ``hc4_pass``
-revises every node of a tape once forward and once backward on one box's slots.
+revises every node of a tape once forward and once backward on one box's slots. The ops are in
+families (:data:`FAMILIES`); a caller passes ``True`` for the families its tape uses and
+``None`` for the others, whose kernels Numba then neither compiles nor loads.
 """
 
 from __future__ import annotations
@@ -19,7 +21,7 @@ from ..interval import arith as ar
 from ..interval import explog as el
 from ..interval import trig as tr
 
-__all__ = ["OP_CODES", "hc4_pass", "revise"]
+__all__ = ["FAMILIES", "OP_CODES", "family_flags", "hc4_pass", "revise"]
 
 OP_CODES = _C = {name: i for i, name in enumerate(OPS)}
 NEG, SQR, SQRT, EXP, LOG, SIN, COS, TAN = (_C[k] for k in
@@ -55,74 +57,23 @@ _b_sin, _b_cos, _b_tan, _b_asin, _b_acos = (tr._sin_rev.scalar, tr._cos_rev.scal
                                             tr._acos_rev.scalar)
 
 
-@nb.njit(cache=True, error_model="numpy")
-def _forward(code, xl, xh, yl, yh, p, buf):
-    """Image of node ``code`` into ``buf[0:2]``."""
-    o0, o1 = buf[0:1], buf[1:2]
-    if code == POWN:
-        _f_pown(xl, xh, np.int64(p), o0, o1)
-    elif code == EXP:
-        buf[0], buf[1] = _f_exp(xl, xh, math.exp(xl), math.exp(xh))
-    elif code == LOG:
-        buf[0], buf[1] = _f_log(xl, xh, math.log(xl), math.log(xh))
-    elif code == SIN:
-        _f_sin(xl, xh, o0, o1)
-    elif code == COS:
-        _f_cos(xl, xh, o0, o1)
-    elif code == TAN:
-        buf[0], buf[1] = _f_tan(xl, xh, math.tan(xl), math.tan(xh))
-    elif code == ASIN:
-        buf[0], buf[1] = _f_asin(xl, xh, math.asin(xl), math.asin(xh))
-    elif code == ACOS:  # asin is only used where |x| <= 1/2
-        buf[0], buf[1] = _f_acos(xl, xh, math.acos(xl), math.acos(xh),
-                                 math.asin(xl) if abs(xl) <= 0.5 else 0.0,
-                                 math.asin(xh) if abs(xh) <= 0.5 else 0.0)
-    elif code == ATAN:
-        buf[0], buf[1] = _f_atan(xl, xh, math.atan(xl), math.atan(xh))
-    elif code == SINH:
-        buf[0], buf[1] = _f_sinh(xl, xh, math.sinh(xl), math.sinh(xh))
-    elif code == COSH:
-        buf[0], buf[1] = _f_cosh(xl, xh, math.cosh(xl), math.cosh(xh))
-    elif code == TANH:
-        buf[0], buf[1] = _f_tanh(xl, xh, math.tanh(xl), math.tanh(xh))
-    elif code == POW:
-        _f_pow(xl, xh, yl, yh, o0, o1)
-    else:  # ATAN2
-        _f_atan2(xl, xh, yl, yh, o0, o1)
+#: The op families: ``propagate_kernel`` is compiled (and cached) once per combination of
+#: families a tape uses, each family's kernels only where it is used; the basic arithmetic
+#: (+, -, *, /, sqr, sqrt, neg) is always there.
+FAMILIES: dict[str, tuple[int, ...]] = {
+    "piecewise": (ABS, SIGN, FLOOR, CEIL, MIN, MAX),
+    "pown": (POWN,),
+    "explog": (EXP, LOG, SINH, COSH, TANH, ATAN, ATAN2, POW),
+    "trig": (SIN, COS, TAN, ASIN, ACOS),
+}
 
 
-@nb.njit(cache=True, error_model="numpy")
-def _backward(code, zl, zh, xl, xh, yl, yh, p, buf):
-    """Projections of node ``code`` into ``buf[0:2]`` (x) and ``buf[2:4]`` (y)."""
-    o0, o1, o2, o3 = buf[0:1], buf[1:2], buf[2:3], buf[3:4]
-    if code == POW:
-        _b_pow(zl, zh, xl, xh, yl, yh, o0, o1, o2, o3)
-    elif code == ATAN2:
-        _b_atan2(zl, zh, xl, xh, yl, yh, o0, o1, o2, o3)
-    elif code == POWN:
-        _b_pown(zl, zh, xl, xh, np.int64(p), o0, o1)
-    elif code == EXP:
-        _b_exp(zl, zh, xl, xh, o0, o1)
-    elif code == LOG:
-        _b_log(zl, zh, xl, xh, o0, o1)
-    elif code == SIN:
-        _b_sin(zl, zh, xl, xh, o0, o1)
-    elif code == COS:
-        _b_cos(zl, zh, xl, xh, o0, o1)
-    elif code == TAN:
-        _b_tan(zl, zh, xl, xh, o0, o1)
-    elif code == ASIN:
-        _b_asin(zl, zh, xl, xh, o0, o1)
-    elif code == ACOS:
-        _b_acos(zl, zh, xl, xh, o0, o1)
-    elif code == ATAN:
-        _b_atan(zl, zh, xl, xh, o0, o1)
-    elif code == SINH:
-        _b_sinh(zl, zh, xl, xh, o0, o1)
-    elif code == COSH:
-        _b_cosh(zl, zh, xl, xh, o0, o1)
-    else:  # TANH
-        _b_tanh(zl, zh, xl, xh, o0, o1)
+def family_flags(op: np.ndarray) -> tuple[bool | None, ...]:
+    """The family arguments of ``propagate_kernel`` for a tape with op codes ``op``: ``True``
+    for a family some node uses, ``None`` for the others (Numba prunes their branches before
+    compiling, so their kernels are neither compiled nor loaded)."""
+    used = set(np.unique(op).tolist())
+    return tuple(True if used & set(codes) else None for codes in FAMILIES.values())
 
 
 @nb.njit(cache=True, inline="always", error_model="numpy")
@@ -132,34 +83,9 @@ def _cap(zl, zh, nl, nh):
 
 
 @nb.njit(cache=True, error_model="numpy")
-def revise(code, zl, zh, xl, xh, yl, yh, p, buf):
-    """HC4-revise of node ``z = f(x, y)``: ``z ∩= f(x, y)``, then ``(x, y) = f_rev(z, x, y)``.
-
-    Returns the new ``(zl, zh, xl, xh, yl, yh)``. The frequent operations are kernels returning
-    tuples (one dispatch, no memory traffic); the others go through ``buf``.
-    """
-    if code == ADD:
-        zl, zh = _cap(zl, zh, _add_lo(xl, xh, yl, yh), _add_hi(xl, xh, yl, yh))
-        xl, xh, yl, yh = al._add_rev_all(zl, zh, xl, xh, yl, yh)
-    elif code == MUL:
-        zl, zh = _cap(zl, zh, _mul_lo(xl, xh, yl, yh), _mul_hi(xl, xh, yl, yh))
-        xl, xh, yl, yh = al._mul_rev_all(zl, zh, xl, xh, yl, yh)
-    elif code == SUB:
-        zl, zh = _cap(zl, zh, _sub_lo(xl, xh, yl, yh), _sub_hi(xl, xh, yl, yh))
-        xl, xh, yl, yh = al._sub_rev_all(zl, zh, xl, xh, yl, yh)
-    elif code == DIV:
-        zl, zh = _cap(zl, zh, _div_lo(xl, xh, yl, yh), _div_hi(xl, xh, yl, yh))
-        xl, xh, yl, yh = al._div_rev_all(zl, zh, xl, xh, yl, yh)
-    elif code == SQR:
-        zl, zh = _cap(zl, zh, _sqr_lo(xl, xh), _sqr_hi(xl, xh))
-        xl, xh = al._sqr_rev_all(zl, zh, xl, xh)
-    elif code == SQRT:
-        zl, zh = _cap(zl, zh, _sqrt_lo(xl, xh), _sqrt_hi(xl, xh))
-        xl, xh = al._sqrt_rev_all(zl, zh, xl, xh)
-    elif code == NEG:
-        zl, zh = _cap(zl, zh, -xh, -xl)
-        xl, xh = al._neg_rev_all(zl, zh, xl, xh)
-    elif code == MIN:
+def _revise_piecewise(code, zl, zh, xl, xh, yl, yh):
+    """HC4-revise of the piecewise nodes (abs, sign, floor, ceil, min, max)."""
+    if code == MIN:
         nl, nh = al._min_all(xl, xh, yl, yh)
         zl, zh = _cap(zl, zh, nl, nh)
         xl, xh, yl, yh = al._min_rev_all(zl, zh, xl, xh, yl, yh)
@@ -183,17 +109,143 @@ def revise(code, zl, zh, xl, xh, yl, yh, p, buf):
         nl, nh = al._ceil_all(xl, xh)
         zl, zh = _cap(zl, zh, nl, nh)
         xl, xh = al._ceil_rev_all(zl, zh, xl, xh)
-    else:
-        _forward(code, xl, xh, yl, yh, p, buf)
-        zl, zh = _cap(zl, zh, buf[0], buf[1])
-        _backward(code, zl, zh, xl, xh, yl, yh, p, buf)
-        xl, xh, yl, yh = buf[0], buf[1], buf[2], buf[3]
     return zl, zh, xl, xh, yl, yh
 
 
 @nb.njit(cache=True, error_model="numpy")
-def hc4_pass(op, out, a, b, param, lo, hi, buf):
-    """Revise nodes ``0..n-1`` then ``n-1..0`` of a tape on the slots ``lo``/``hi`` (in place).
+def _revise_pown(zl, zh, xl, xh, p, buf):
+    """HC4-revise of a ``pown`` node (integer exponent ``p``)."""
+    o0, o1 = buf[0:1], buf[1:2]
+    _f_pown(xl, xh, np.int64(p), o0, o1)
+    zl, zh = _cap(zl, zh, buf[0], buf[1])
+    _b_pown(zl, zh, xl, xh, np.int64(p), o0, o1)
+    return zl, zh, buf[0], buf[1]
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _revise_explog(code, zl, zh, xl, xh, yl, yh, buf):
+    """HC4-revise of the exponential family (exp, log, sinh, cosh, tanh, atan, atan2, and the
+    real power ``pow(x, y) = exp(y log x)``)."""
+    o0, o1, o2, o3 = buf[0:1], buf[1:2], buf[2:3], buf[3:4]
+    if code == POW:
+        _f_pow(xl, xh, yl, yh, o0, o1)
+        zl, zh = _cap(zl, zh, buf[0], buf[1])
+        _b_pow(zl, zh, xl, xh, yl, yh, o0, o1, o2, o3)
+        return zl, zh, buf[0], buf[1], buf[2], buf[3]
+    if code == ATAN2:
+        _f_atan2(xl, xh, yl, yh, o0, o1)
+        zl, zh = _cap(zl, zh, buf[0], buf[1])
+        _b_atan2(zl, zh, xl, xh, yl, yh, o0, o1, o2, o3)
+        return zl, zh, buf[0], buf[1], buf[2], buf[3]
+    if code == EXP:
+        nl, nh = _f_exp(xl, xh, math.exp(xl), math.exp(xh))
+    elif code == LOG:
+        nl, nh = _f_log(xl, xh, math.log(xl), math.log(xh))
+    elif code == SINH:
+        nl, nh = _f_sinh(xl, xh, math.sinh(xl), math.sinh(xh))
+    elif code == COSH:
+        nl, nh = _f_cosh(xl, xh, math.cosh(xl), math.cosh(xh))
+    elif code == TANH:
+        nl, nh = _f_tanh(xl, xh, math.tanh(xl), math.tanh(xh))
+    elif code == ATAN:
+        nl, nh = _f_atan(xl, xh, math.atan(xl), math.atan(xh))
+    else:
+        return zl, zh, xl, xh, yl, yh
+    zl, zh = _cap(zl, zh, nl, nh)
+    if code == EXP:
+        _b_exp(zl, zh, xl, xh, o0, o1)
+    elif code == LOG:
+        _b_log(zl, zh, xl, xh, o0, o1)
+    elif code == SINH:
+        _b_sinh(zl, zh, xl, xh, o0, o1)
+    elif code == COSH:
+        _b_cosh(zl, zh, xl, xh, o0, o1)
+    elif code == TANH:
+        _b_tanh(zl, zh, xl, xh, o0, o1)
+    else:  # ATAN
+        _b_atan(zl, zh, xl, xh, o0, o1)
+    return zl, zh, buf[0], buf[1], yl, yh
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _revise_trig(code, zl, zh, xl, xh, yl, yh, buf):
+    """HC4-revise of the trigonometric family (sin, cos, tan, asin, acos)."""
+    o0, o1 = buf[0:1], buf[1:2]
+    if code == SIN:
+        _f_sin(xl, xh, o0, o1)
+    elif code == COS:
+        _f_cos(xl, xh, o0, o1)
+    elif code == TAN:
+        buf[0], buf[1] = _f_tan(xl, xh, math.tan(xl), math.tan(xh))
+    elif code == ASIN:
+        buf[0], buf[1] = _f_asin(xl, xh, math.asin(xl), math.asin(xh))
+    elif code == ACOS:  # asin is only used where |x| <= 1/2
+        buf[0], buf[1] = _f_acos(xl, xh, math.acos(xl), math.acos(xh),
+                                 math.asin(xl) if abs(xl) <= 0.5 else 0.0,
+                                 math.asin(xh) if abs(xh) <= 0.5 else 0.0)
+    else:
+        return zl, zh, xl, xh, yl, yh
+    zl, zh = _cap(zl, zh, buf[0], buf[1])
+    if code == SIN:
+        _b_sin(zl, zh, xl, xh, o0, o1)
+    elif code == COS:
+        _b_cos(zl, zh, xl, xh, o0, o1)
+    elif code == TAN:
+        _b_tan(zl, zh, xl, xh, o0, o1)
+    elif code == ASIN:
+        _b_asin(zl, zh, xl, xh, o0, o1)
+    else:  # ACOS
+        _b_acos(zl, zh, xl, xh, o0, o1)
+    return zl, zh, buf[0], buf[1], yl, yh
+
+
+@nb.njit(cache=True, error_model="numpy")
+def revise(code, zl, zh, xl, xh, yl, yh, p, buf, piecewise, pown, explog, trig):
+    """HC4-revise of node ``z = f(x, y)``: ``z ∩= f(x, y)``, then ``(x, y) = f_rev(z, x, y)``.
+
+    Returns the new ``(zl, zh, xl, xh, yl, yh)``. The basic arithmetic is inline; each other
+    family is one kernel, compiled in only when its argument (``piecewise``, ``pown``,
+    ``explog``, ``trig``) is not ``None`` (Numba prunes ``x is not None`` on a ``None``
+    argument before typing). A node of a family left out is not contracted, which is sound.
+    """
+    if code == ADD:
+        zl, zh = _cap(zl, zh, _add_lo(xl, xh, yl, yh), _add_hi(xl, xh, yl, yh))
+        xl, xh, yl, yh = al._add_rev_all(zl, zh, xl, xh, yl, yh)
+    elif code == MUL:
+        zl, zh = _cap(zl, zh, _mul_lo(xl, xh, yl, yh), _mul_hi(xl, xh, yl, yh))
+        xl, xh, yl, yh = al._mul_rev_all(zl, zh, xl, xh, yl, yh)
+    elif code == SUB:
+        zl, zh = _cap(zl, zh, _sub_lo(xl, xh, yl, yh), _sub_hi(xl, xh, yl, yh))
+        xl, xh, yl, yh = al._sub_rev_all(zl, zh, xl, xh, yl, yh)
+    elif code == DIV:
+        zl, zh = _cap(zl, zh, _div_lo(xl, xh, yl, yh), _div_hi(xl, xh, yl, yh))
+        xl, xh, yl, yh = al._div_rev_all(zl, zh, xl, xh, yl, yh)
+    elif code == SQR:
+        zl, zh = _cap(zl, zh, _sqr_lo(xl, xh), _sqr_hi(xl, xh))
+        xl, xh = al._sqr_rev_all(zl, zh, xl, xh)
+    elif code == SQRT:
+        zl, zh = _cap(zl, zh, _sqrt_lo(xl, xh), _sqrt_hi(xl, xh))
+        xl, xh = al._sqrt_rev_all(zl, zh, xl, xh)
+    elif code == NEG:
+        zl, zh = _cap(zl, zh, -xh, -xl)
+        xl, xh = al._neg_rev_all(zl, zh, xl, xh)
+    else:
+        if pown is not None and code == POWN:
+            zl, zh, xl, xh = _revise_pown(zl, zh, xl, xh, p, buf)
+            return zl, zh, xl, xh, yl, yh
+        if piecewise is not None and code in (ABS, SIGN, FLOOR, CEIL, MIN, MAX):
+            return _revise_piecewise(code, zl, zh, xl, xh, yl, yh)
+        if explog is not None and code in (EXP, LOG, SINH, COSH, TANH, ATAN, ATAN2, POW):
+            return _revise_explog(code, zl, zh, xl, xh, yl, yh, buf)
+        if trig is not None:
+            return _revise_trig(code, zl, zh, xl, xh, yl, yh, buf)
+    return zl, zh, xl, xh, yl, yh
+
+
+@nb.njit(cache=True, error_model="numpy")
+def hc4_pass(op, out, a, b, param, lo, hi, buf, piecewise, pown, explog, trig):
+    """Revise nodes ``0..n-1`` then ``n-1..0`` of a tape on the slots ``lo``/``hi`` (in place;
+    the family flags as in :func:`revise`).
 
     Each revision intersects the node's three slots with their contracted domains, so every
     slot only shrinks and holds every solution it held. Returns False as soon as a slot becomes
@@ -205,7 +257,7 @@ def hc4_pass(op, out, a, b, param, lo, hi, buf):
         o, ia, ib = out[i], a[i], b[i]
         yl, yh = (lo[ib], hi[ib]) if ib >= 0 else (0.0, 0.0)
         zl, zh, xl, xh, yl, yh = revise(op[i], lo[o], hi[o], lo[ia], hi[ia], yl, yh, param[i],
-                                        buf)
+                                        buf, piecewise, pown, explog, trig)
         if not (_meet(lo, hi, o, zl, zh) and _meet(lo, hi, ia, xl, xh)):
             return False
         if ib >= 0 and not _meet(lo, hi, ib, yl, yh):

@@ -194,12 +194,24 @@ def _setup(system: DiscreteSystem, y: Interval, x0: Interval | None, x_prior: In
 
 
 def _progress(total: int, desc: str, show: bool) -> tuple[Callable[[], None], Any]:
+    """A tick per local operator call and its bar; ``total`` must be the exact number of calls
+    (``_calls``), so that the bar ends at its total."""
     if not show:
         return (lambda: None), None
     from tqdm import tqdm
 
     bar = tqdm(total=total, desc=desc, unit="op", leave=False)
     return (lambda: bar.update(1)), bar
+
+
+def _calls(K: int, ops: BoxSets | PavingSets, estimator: str) -> int:
+    """Local operator calls of ``ncse``/``rcse`` on the chain of ``K`` steps (``2K`` arcs):
+    FALL-CLIMB contracts every arc twice (``4K``); RCSE runs it on the priors when ``_initial``
+    does, then three operators per step."""
+    if estimator == "ncse":
+        return 4 * K
+    initial = not (isinstance(ops, PavingSets) and not ops.informative_priors)
+    return 3 * K + (4 * K if initial else 0)
 
 
 def ncse(system: DiscreteSystem, y: Interval, *, x0: Interval | None = None,
@@ -229,7 +241,7 @@ def ncse(system: DiscreteSystem, y: Interval, *, x0: Interval | None = None,
         The contracted domains of every ``x_k`` and ``y_k`` given all the measurements.
     """
     K, ops, xs, ys, meas = _setup(system, y, x0, x_prior, y_prior, domains, eps, max_boxes)
-    tick, bar = _progress(3 * K, "NCSE", progress)
+    tick, bar = _progress(_calls(K, ops, "ncse"), "NCSE", progress)
     tree = _chain(system, K, ops, tick)
     t0 = time.perf_counter()
     doms: dict = {_xn(k): xs[k] for k in range(K + 1)}
@@ -269,7 +281,7 @@ def rcse(system: DiscreteSystem, y: Interval, *, x0: Interval | None = None,
     the whole SCSP at time ``k`` (Jaulin et al. 2001, Theorem 8).
     """
     K, ops, xs, ys, meas = _setup(system, y, x0, x_prior, y_prior, domains, eps, max_boxes)
-    tick, bar = _progress(3 * K, "RCSE", progress)
+    tick, bar = _progress(_calls(K, ops, "rcse"), "RCSE", progress)
     tree = _chain(system, K, ops, tick)
     arcs = {(a.a, a.b): a for a in tree.arcs}
     t0 = time.perf_counter()

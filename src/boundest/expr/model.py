@@ -16,12 +16,14 @@ class Model:
     """Variables (name -> scalar interval domain) and constraints over them.
 
     Variables used by a constraint but not declared get the entire line as domain.
-    ``options`` keeps header lines of a model file (e.g. RealPaver's ``Bisection none;``).
+    ``options`` keeps header lines of a model file (e.g. RealPaver's ``Bisection none;``),
+    ``option_lines`` the line of each in the file.
     """
 
     domains: dict[str, Interval] = field(default_factory=dict)
     constraints: list[Constraint] = field(default_factory=list)
     options: dict[str, str] = field(default_factory=dict)
+    option_lines: dict[str, int] = field(default_factory=dict)
 
     def declare(self, var: Var | str, domain: Interval | tuple[float, float] | None = None
                 ) -> Var:

@@ -225,6 +225,7 @@ class _Build(Transformer):
     def option(self, items):
         key, value = items
         self.model.options[str(key)] = str(value)
+        self.model.option_lines[str(key)] = key.line
 
     def bound(self, items):
         sign = -1.0 if str(items[0]) == "-" else 1.0

@@ -79,7 +79,7 @@ _bmin = min
 _bmax = max
 _bany = any
 
-_jit = nb.njit(inline="always", cache=True, error_model="numpy")
+_jit = nb.njit(cache=True, error_model="numpy")
 #: Larger helpers (loops) are compiled once and called, not inlined everywhere.
 _jit_call = nb.njit(cache=True, error_model="numpy")
 

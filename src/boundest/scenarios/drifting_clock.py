@@ -285,13 +285,15 @@ def _item(a: Interval, i: int) -> Interval:
 
 
 def solve(meas: ClockMeasurements | None = None, dt: float = 0.01, tf: float | None = None,
-          rel_eps: float = 1e-4, max_iter: int = 100) -> ClockResult:
+          rel_eps: float = 1e-4, max_iter: int = 100, progress: bool | None = None
+          ) -> ClockResult:
     """Contract CN (20) over ``[0, tf]`` (default :func:`t_final`) sliced every ``dt``.
 
     Each iteration applies ``x' = v``, the distance functions, ``y' = w``, ``h' = phi``, then for
     every measurement ``tau_i = h(t_i)``, ``z_i = y(t_i)`` and ``tau_i = h(t_i)`` again (CtcEval
     each). It stops as :meth:`ContractorNetwork.contract` does (relative decrease of the total
-    width below ``rel_eps``), or when a domain becomes empty.
+    width below ``rel_eps``), or when a domain becomes empty. ``progress``: the network's
+    iteration counter with the last contraction (``None``: only for runs longer than 2 s).
     """
     meas = load() if meas is None else meas
     if not (np.isfinite(dt) and dt > 0):
@@ -331,6 +333,6 @@ def solve(meas: ClockMeasurements | None = None, dt: float = 0.01, tf: float | N
         cn.add(ev, [ti, _item(z, i), y, w])
         cn.add(ev, [ti, taui, h, phi])
     build_s = time.perf_counter() - start
-    rep = cn.contract(rel_eps=rel_eps, max_iter=max_iter, progress=False)
+    rep = cn.contract(rel_eps=rel_eps, max_iter=max_iter, progress=progress)
     return ClockResult(meas, h, y, t_i, t_initial, z, rep.iterations, rep.converged, rep.empty,
                        rep.time_s, build_s, list(rep.contraction))

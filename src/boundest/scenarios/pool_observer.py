@@ -155,8 +155,8 @@ def _ping(sl, sh, alpha, dl, dh, par, tp, ol, oh, scratch):
     # 2^-40 covers its rounding (the reading's box holds that float, not the exact distance)
     bl[3], bh[3] = dl - _D_PAD * abs(dl), dh + _D_PAD * abs(dh)
     if not raycast_box(bl, bh, par[PASSES], 3, tp[0], tp[1], tp[2], tp[3], tp[4], tp[5], tp[6],
-                       tp[7], tp[8], tp[9], tp[10], tp[11], tp[12], scratch[2], scratch[3],
-                       scratch[4]):
+                       tp[7], tp[8], tp[9], tp[10], tp[11], tp[12], tp[13], tp[14], tp[15],
+                       tp[16], scratch[2], scratch[3], scratch[4]):
         return False
     ol[0], oh[0], ol[1], oh[1] = bl[0], bh[0], bl[1], bh[1]
     ol[2] = max(sl[2], _sub_lo(bl[2], bh[2], alpha, alpha))

@@ -1,0 +1,213 @@
+"""``boundest solve MODEL``: propagate a model file, print a summary, optionally pave it.
+
+The header options of the file (``Bisection none;``) are honoured or refused, never ignored:
+``Bisection none;`` asks for propagation only (the default), ``Bisection EPS;`` (a number) for
+a subpaving of precision ``EPS`` as ``--paving EPS`` does; any other option is an error naming
+the file and line. ``--paving`` on the command line overrides the file's ``Bisection``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import re
+import statistics
+from pathlib import Path
+from typing import Any
+
+from . import pyplot, save_figure, write_json
+
+#: Subpavings are computed for models of at most this many variables (SIVIA bisects every
+#: dimension; beyond a few the number of boxes explodes).
+MAX_PAVING_VARIABLES = 12
+_FAMILY = re.compile(r"^(.*?)_?(\d+)$")
+
+
+def _width(lo: float, hi: float) -> float:
+    return hi - lo
+
+
+def header_paving(model: Any, path: str) -> float | None:
+    """The paving precision the model file's header asks for (``None``: propagation only).
+
+    Raises
+    ------
+    ValueError
+        Naming ``path`` and the line of an option boundest does not implement.
+    """
+    eps = None
+    for key, value in model.options.items():
+        line = model.option_lines.get(key, "?")
+        if key.lower() == "bisection":
+            if value.lower() == "none":
+                continue
+            try:
+                eps = float(value)
+            except ValueError:
+                eps = None
+            if eps is None or not eps > 0.0 or eps == float("inf"):
+                raise ValueError(f"{path}:{line}: 'Bisection {value};' is not supported: "
+                                 "boundest reads 'Bisection none;' (propagation only) or "
+                                 "'Bisection EPS;' with a positive number EPS (a subpaving "
+                                 "of that precision)")
+            continue
+        raise ValueError(f"{path}:{line}: header option '{key} {value};' is not supported by "
+                         "boundest solve (only 'Bisection none;' and 'Bisection EPS;'); "
+                         "remove it")
+    return eps
+
+
+def families(names: list[str]) -> dict[str, list[str]]:
+    """Variables grouped by family: ``x1_0 ... x1_200`` are the family ``x1``; a name without
+    a trailing index is a family of its own. In order of first appearance."""
+    out: dict[str, list[str]] = {}
+    for name in names:
+        m = _FAMILY.match(name)
+        key = m.group(1) if m and m.group(1) else name
+        out.setdefault(key, []).append(name)
+    return out
+
+
+def summary_lines(domains: dict[str, Any], widest: int = 5, max_rows: int = 30) -> list[str]:
+    """The printed summary of the final domains: counts, one row per family (number of
+    variables, min / median / max width, how many unbounded) and the widest variables."""
+    bounds = {n: (float(d.lo), float(d.hi)) for n, d in domains.items()}
+    empty = [n for n, (lo, hi) in bounds.items() if lo != lo]
+    unbounded = [n for n, (lo, hi) in bounds.items() if lo == lo and _width(lo, hi) == float("inf")]
+    lines = [f"domains: {len(bounds)} variables, {len(bounds) - len(empty) - len(unbounded)} "
+             f"bounded, {len(unbounded)} unbounded, {len(empty)} empty"]
+    if empty:
+        return lines
+    fams = families(list(bounds))
+    name_w = max(len("family"), *(len(f) for f in fams)) if fams else len("family")
+    lines.append(f"  {'family':<{name_w}} {'count':>6}  {'index range':<13} {'min width':>11} "
+                 f"{'median':>11} {'max width':>11}  unbounded")
+    for i, (fam, members) in enumerate(fams.items()):
+        if i == max_rows:
+            lines.append(f"  ... {len(fams) - max_rows} more families (--all prints every "
+                         "variable)")
+            break
+        w = [_width(*bounds[n]) for n in members]
+        idx = [m.group(2) for n in members if (m := _FAMILY.match(n))]
+        span = f"{idx[0]}..{idx[-1]}" if len(members) > 1 and len(idx) == len(members) else ""
+        n_unb = sum(x == float("inf") for x in w)
+        lines.append(f"  {fam:<{name_w}} {len(members):>6}  {span:<13} {min(w):>11.4g} "
+                     f"{statistics.median(w):>11.4g} {max(w):>11.4g}  {n_unb}")
+    finite = sorted((n for n in bounds if n not in unbounded),
+                    key=lambda n: -_width(*bounds[n]))[:widest]
+    if finite:
+        lines.append("widest bounded domains: " + ", ".join(
+            f"{n} in [{bounds[n][0]:.6g}, {bounds[n][1]:.6g}]" for n in finite))
+    if unbounded:
+        lines.append(f"unbounded: {', '.join(unbounded[:widest])}"
+                     + (f" and {len(unbounded) - widest} more" if len(unbounded) > widest
+                        else ""))
+    return lines
+
+
+def pave(model: Any, domains: dict[str, Any], eps: float, max_boxes: int) -> Any:
+    """SIVIA on the propagated domains with the model's forward-backward contractor: an
+    outer subpaving (boundary boxes whose union contains every solution; no inner test)."""
+    import numpy as np
+
+    from ..ctc import CtcFwdBwd
+    from ..interval import Interval
+    from ..paving import sivia
+
+    names = list(domains)
+    if len(names) > MAX_PAVING_VARIABLES:
+        raise ValueError(f"a subpaving is computed for at most {MAX_PAVING_VARIABLES} variables; "
+                         f"the model has {len(names)} (propagation alone: 'Bisection none;' or "
+                         "no --paving)")
+    lo = np.array([float(domains[n].lo) for n in names])
+    hi = np.array([float(domains[n].hi) for n in names])
+    unb = [n for n, a, b in zip(names, lo, hi, strict=True) if not np.isfinite(b - a)]
+    if unb:
+        raise ValueError(f"a subpaving needs bounded domains; after propagation "
+                         f"{', '.join(unb)} {'is' if len(unb) == 1 else 'are'} unbounded")
+    ctc = CtcFwdBwd(model.constraints, names)
+    return sivia(Interval._new(lo, hi), ctc_out=ctc, eps=eps, max_boxes=max_boxes)
+
+
+def run(args: argparse.Namespace) -> int:
+    """``boundest solve``: propagate, print the summary (every domain with ``--all``), pave."""
+    from ..csp import propagate
+    from ..expr import load_model
+
+    model = load_model(args.file)
+    eps = header_paving(model, args.file)
+    if args.paving is not None:
+        if not args.paving > 0.0:
+            raise ValueError(f"--paving must be a positive precision, got {args.paving}")
+        eps = args.paving
+    res = propagate(model, rel_eps=args.rel_eps)
+    status = "consistent" if res.consistent else "INCONSISTENT (no solution)"
+    print(f"{args.file}: {len(model.domains)} variables, {len(model.constraints)} constraints: "
+          f"{status}; {res.evaluations} node revisions in {res.time_s:.3f} s")
+    if args.all:
+        width = max((len(n) for n in res.domains), default=0)
+        for name, dom in res.domains.items():
+            text = ("[empty]" if bool(dom.is_empty())
+                    else f"[{float(dom.lo)!r}, {float(dom.hi)!r}]")
+            print(f"  {name:<{width}} in {text}")
+    else:
+        for line in summary_lines(res.domains):
+            print(line)
+        print("(--all prints every domain; --json writes them)")
+    data: dict[str, Any] = {"file": str(args.file), "consistent": res.consistent,
+                            "evaluations": res.evaluations, "time_s": res.time_s,
+                            "domains": res.domains}
+    paving = None
+    if eps is not None and res.consistent:
+        paving = pave(model, res.domains, eps, args.max_boxes)
+        st = paving.stats
+        empty = len(paving) == 0
+        print(f"subpaving (SIVIA, eps = {eps:g}): {len(paving)} boundary boxes"
+              + (" (empty: no solution)" if empty else "")
+              + f", {st.get('processed', '?')} boxes classified, stopped by "
+              f"{st.get('stopped', '?')}; their union contains every solution (no inner test)")
+        if not empty:
+            hull = paving.hull()
+            print("  hull: " + ", ".join(f"{n} in [{float(a):.6g}, {float(b):.6g}]" for n, a, b
+                                         in zip(res.domains, hull.lo, hull.hi, strict=True)))
+        data["paving"] = {"eps": eps, "variables": list(res.domains),
+                          "boxes": paving.boxes, "stopped": st.get("stopped")}
+        if paving.dim >= 2 and not empty:
+            plt = pyplot()
+            from ..plot.paving import plot_paving
+
+            names = list(res.domains)
+            fig, ax = plt.subplots(figsize=(6, 5.5))
+            plot_paving(paving, ax=ax, dims=(0, 1))
+            ax.set_xlabel(names[0])
+            ax.set_ylabel(names[1])
+            ax.set_title(f"{Path(args.file).name}: subpaving projected on ({names[0]}, "
+                         f"{names[1]})\nyellow: boundary boxes (may hold solutions)",
+                         fontsize=9)
+            save_figure(fig, args.out, f"{Path(args.file).stem}_paving")
+        if empty:
+            write_json(data, args.json)
+            return 1
+    write_json(data, args.json)
+    return 0 if res.consistent else 1
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add ``boundest solve`` and its options."""
+    p = sub.add_parser("solve", help="propagate a model file; print a summary of the domains "
+                                     "(and a subpaving with --paving)")
+    p.add_argument("file", help="model in the text format (docs/model-format.md)")
+    p.add_argument("--rel-eps", type=float, default=1e-3,
+                   help="propagation stops when no domain shrinks by more than this fraction "
+                        "of its width (default 1e-3)")
+    p.add_argument("--all", action="store_true",
+                   help="print every variable's domain instead of the summary")
+    p.add_argument("--paving", type=float, metavar="EPS",
+                   help="after propagation, bisect with SIVIA to boxes narrower than EPS: an "
+                        f"outer subpaving (for models of at most {MAX_PAVING_VARIABLES} "
+                        "bounded variables; overrides the file's 'Bisection' option)")
+    p.add_argument("--max-boxes", type=int, default=100_000,
+                   help="SIVIA stops before exceeding this many boxes (default 100000)")
+    p.add_argument("--out", default="out", help="folder for the subpaving figure (default: out)")
+    p.add_argument("--json", help="write every domain (and the subpaving's boxes) as JSON to "
+                                  "this file (strict JSON: docs/json.md)")
+    p.set_defaults(func=run)

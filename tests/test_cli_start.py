@@ -1,0 +1,74 @@
+"""``boundest --help`` and argument errors load neither NumPy nor Numba; the parser imports
+only the scenario it runs; a run that compiles says so once on standard error."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import pytest
+
+from boundest.cli import build_parser
+from boundest.commands import SCENARIOS
+
+PROBE = """
+import sys
+from boundest.cli import main
+try:
+    main({argv!r})
+except SystemExit as e:
+    print("exit", e.code)
+heavy = [m for m in ("numpy", "numba", "matplotlib", "boundest.interval") if m in sys.modules]
+print("loaded", heavy)
+"""
+
+
+@pytest.mark.parametrize("argv", [["--help"], ["run", "--help"], ["run", "satellite", "--help"],
+                                  ["run", "satellite", "--kmax", "3"], ["solve"],
+                                  ["run", "nosuch"], ["--version"]])
+def test_help_and_argument_errors_load_no_numerical_layer(argv):
+    out = subprocess.run([sys.executable, "-c", PROBE.format(argv=argv)], capture_output=True,
+                         text=True, timeout=120)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.strip().endswith("loaded []"), out.stdout
+
+
+def test_the_parser_lists_every_scenario_and_registers_the_one_named():
+    for name in SCENARIOS:
+        args = build_parser(["run", name]).parse_args(["run", name])
+        assert args.scenario == name and callable(args.func)
+    full = build_parser()
+    assert full.parse_args(["run", "satellite", "--kmax", "800"]).kmax == 800
+    with pytest.raises(SystemExit):
+        build_parser(["run", "pool"]).parse_args(["run", "satellite", "--kmax", "800"])
+
+
+def test_boundest_package_attributes_are_loaded_on_access():
+    import boundest as bd
+
+    assert bd.Box is bd.IntervalVector and bd.sin.__module__ == "boundest.expr.functions"
+    assert "Interval" in bd.__all__ and "abs" not in bd.__all__ and "Tube" in dir(bd)
+    assert bd.tube.Tube is bd.Tube
+    with pytest.raises(AttributeError):
+        bd.no_such_name  # noqa: B018
+
+
+COMPILES = """
+from boundest.cli import main
+main(["solve", {model!r}])
+"""
+
+
+def test_a_compiling_run_says_so_once_and_a_cached_run_does_not(tmp_path):
+    model = tmp_path / "m.txt"
+    model.write_text("x in [0, 1], y in [0, 1];\nConstraints\nx + y = 1.5, x * y >= 0.1;\n")
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+    errs = []
+    for _ in range(2):
+        out = subprocess.run([sys.executable, "-c", COMPILES.format(model=str(model))], env=env,
+                             capture_output=True, text=True, timeout=900)
+        assert out.returncode == 0, out.stderr[-2000:]
+        errs.append([line for line in out.stderr.splitlines() if "compiling" in line])
+    assert len(errs[0]) == 1 and "boundest solve" in errs[0][0] and "about" in errs[0][0]
+    assert errs[1] == []
