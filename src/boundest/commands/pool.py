@@ -16,8 +16,6 @@ import argparse
 import time
 from pathlib import Path
 
-import numpy as np
-
 from . import pyplot, save_figure, write_json
 
 GUARANTEE = {
@@ -34,6 +32,8 @@ GUARANTEE = {
 def table_rows(data, res, rows: int = 10) -> list[dict]:
     """The paper's table: ``rows`` steps at regular times, with the window probability and the
     pings rejected in the window."""
+    import numpy as np
+
     from ..plot.pool import window_of
 
     ks = np.unique(np.rint(np.linspace(0, data.n - 1, rows)).astype(int))
@@ -51,14 +51,18 @@ def format_table(rows: list[dict], q: int) -> str:
     return "\n".join(lines)
 
 
-def _mean_widths(res) -> tuple[np.ndarray, int]:
+def _mean_widths(res) -> tuple:
     """Mean widths over the steps whose box is bounded (a restart box has an unbounded theta)."""
+    import numpy as np
+
     w = res.widths()
     ok = np.isfinite(w).all(axis=1)
     return (w[ok].mean(axis=0) if ok.any() else np.full(4, np.nan)), int(ok.sum())
 
 
 def run(args: argparse.Namespace) -> int:
+    import numpy as np
+
     from ..scenarios.pool import solve_pool
     from ..scenarios.pool_data import binomial_bound, load_pool
 
@@ -171,6 +175,8 @@ def run(args: argparse.Namespace) -> int:
 
 
 def to_json(data, res, args, p_full: float, rows: list[dict], per_update=None) -> dict:
+    import numpy as np
+
     w, nw = _mean_widths(res)
     c = res.centre()
     steps = [{"k": k, "t": float(data.t[k]), "box": res.boxes[k], "centre": c[k],
@@ -201,6 +207,8 @@ def _sides(eps) -> str:
 
 def _online(data, kw: dict):
     """The mission through :class:`PoolObserver`, one update per ping, each timed."""
+    import numpy as np
+
     from ..interval import Interval
     from ..scenarios.pool import PoolObserver, PoolResult, window_probabilities
 

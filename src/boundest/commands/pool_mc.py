@@ -10,8 +10,6 @@ from collections.abc import Iterator
 from concurrent.futures import Executor, ProcessPoolExecutor
 from pathlib import Path
 
-import numpy as np
-
 from . import pyplot, save_figure, write_json
 
 
@@ -42,6 +40,8 @@ def executor_of(args: argparse.Namespace) -> Iterator[Executor | None]:
 
 def table_rows(mc, rows: int = 12) -> list[dict]:
     """``rows`` steps at regular times: frequency, its 95 % interval, the claimed bound."""
+    import numpy as np
+
     lo, hi = mc.ci()
     freq = mc.frequency()
     ks = np.unique(np.rint(np.linspace(0, mc.t.size - 1, rows)).astype(int))
@@ -63,6 +63,8 @@ def format_table(rows: list[dict]) -> str:
 def run_monte_carlo(args: argparse.Namespace) -> int:
     """Run the Monte Carlo of ``args.monte_carlo`` missions; print, write JSON and the figure.
     Returns 0 when the frequency is at or above the claimed bound at every step, else 1."""
+    import numpy as np
+
     from ..scenarios.pool_mc import pool_monte_carlo
 
     if args.monte_carlo < 1:
