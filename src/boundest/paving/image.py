@@ -28,6 +28,8 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Callable
+from concurrent.futures import Executor
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
@@ -129,7 +131,9 @@ def pave(y: Interval, eps: float) -> Subpaving:
 
 
 def image(sp: Subpaving, f: Callable[[Interval], Interval], *, eps: float,
-          max_boxes: int = 1_000_000, extra: Interval | None = None) -> Subpaving:
+          max_boxes: int = 1_000_000, extra: Interval | None = None,
+          executor: Executor | None = None, split: int = 16384, tasks: int = 64,
+          progress: bool | None = None) -> Subpaving:
     """A subpaving guaranteed to contain ``f(V)``, ``V`` the inside and boundary boxes of ``sp``.
 
     Parameters
@@ -137,15 +141,26 @@ def image(sp: Subpaving, f: Callable[[Interval], Interval], *, eps: float,
     sp : Subpaving
         The set ``V``.
     f : callable
-        Vectorised interval function, ``Interval (b, n) -> Interval (b, m)``.
+        Vectorised interval function, ``Interval (b, n) -> Interval (b, m)`` (picklable, with
+        an executor).
     eps : float
         Target width of the image boxes and step (rounded down to a power of two) of the grid.
     max_boxes : int
         Budget of boxes of ``V`` bisected; beyond it the remaining images are paved as they
-        are (still enclosures, only wider).
+        are (still enclosures, only wider). With an executor each part gets its share of the
+        budget (in proportion to its boxes), so the result depends on ``tasks``, never on the
+        number of workers, and is the in-process one whenever the budget is not reached.
     extra : Interval, optional
         Boxes ``(e, m)`` already known to enclose part of the image (computed by the caller),
         paved together with the images.
+    executor : concurrent.futures.Executor, optional
+        Where to bisect once the frontier holds ``split`` boxes: it is cut into ``tasks``
+        parts of consecutive boxes, each bisected to the end on a worker
+        (:mod:`boundest.parallel`); None: in this process.
+    split, tasks : int
+        With an executor: the frontier size at which the work is cut, and into how many parts.
+    progress : bool or None
+        With an executor: a progress bar over the parts (None: only on a terminal).
 
     Returns
     -------
@@ -159,6 +174,8 @@ def image(sp: Subpaving, f: Callable[[Interval], Interval], *, eps: float,
         raise ValueError(f"image needs a Subpaving, got {type(sp).__name__}")
     if not (np.isfinite(eps) and eps > 0):
         raise ValueError(f"eps must be a positive finite number, got {eps}")
+    if split < 1 or tasks < 1:
+        raise ValueError(f"split and tasks must be at least 1, got {split} and {tasks}")
     m: int | None = None
     done: list[Interval] = []
     if extra is not None:
@@ -167,23 +184,24 @@ def image(sp: Subpaving, f: Callable[[Interval], Interval], *, eps: float,
                              f"{getattr(extra, 'shape', type(extra).__name__)}")
         m = extra.shape[1]
         done.append(extra)
-    frontier = sp.boxes
-    count = 0
-    while frontier.shape[0]:
-        y = _images(f, frontier, m)
-        m = y.shape[1]
-        empty = np.isnan(y.lo).any(axis=1)  # f is undefined on the whole box
-        wide = (y.max_diam() > eps) & ~empty & (frontier.max_diam() > 0)
-        ok = ~wide & ~empty
-        done.append(y[ok])
-        count += int(ok.sum())
-        if count + 2 * int(wide.sum()) > max_boxes:
-            done.append(y[wide])
-            count += int(wide.sum())
-            break
-        left, right = frontier[wide].bisect()
-        frontier = Interval._new(np.concatenate([left.lo, right.lo]),
-                                 np.concatenate([left.hi, right.hi]))
+    head = _bisect(_ImagePart(f, eps, m, max_boxes), sp.boxes,
+                   split=None if executor is None else max(split, tasks))
+    done += head.done
+    count, m = head.count, head.m
+    frontier = head.frontier
+    if frontier.shape[0]:  # cut the rest into parts, each with its share of the budget
+        from ..parallel import map_chunked
+
+        bounds = np.linspace(0, frontier.shape[0], tasks + 1).astype(np.intp)
+        left = max(max_boxes - count, 0)
+        parts = [(frontier[a:b], (left * (b - a)) // frontier.shape[0])
+                 for a, b in itertools.pairwise(bounds) if b > a]
+        runs = map_chunked(_ImagePart(f, eps, m, max_boxes), parts, executor, chunk=1,
+                           progress=progress, desc="image")
+        for r in runs:
+            done += r.done
+            count += r.count
+            m = r.m if m is None else m
     if m is None:  # sp is empty: so is its image (of unknown dimension: keep sp's)
         out = Subpaving.empty(sp.dim)
         out.stats = {"bisected": 0, "images": 0, "cells": 0}
@@ -192,3 +210,57 @@ def image(sp: Subpaving, f: Callable[[Interval], Interval], *, eps: float,
                              np.concatenate([d.hi for d in done]).reshape(-1, m)), eps)
     out.stats = {"bisected": count, **out.stats}
     return out
+
+
+@dataclass
+class _Bisected:
+    """What one bisection loop produced: image boxes, boxes of ``V`` counted, the image's
+    dimension, and the frontier left when it stopped to split."""
+
+    done: list[Interval]
+    count: int
+    m: int | None
+    frontier: Interval
+
+
+@dataclass
+class _ImagePart:
+    """The bisection of one part of ``V`` (run on a worker: a picklable dataclass)."""
+
+    f: Callable[[Interval], Interval]
+    eps: float
+    m: int | None
+    max_boxes: int
+
+    def __call__(self, part: tuple[Interval, int]) -> _Bisected:
+        frontier, budget = part
+        return _bisect(self, frontier, budget=budget)
+
+
+def _bisect(job: _ImagePart, frontier: Interval, *, budget: int | None = None,
+            split: int | None = None) -> _Bisected:
+    """IMAGESP's loop from ``frontier``: image every box, keep the narrow images, bisect the
+    boxes of the wide ones; stop when none is left, before exceeding the ``budget`` (default
+    ``job.max_boxes``; the wide images are then kept as they are), or (``split``) once the
+    frontier holds at least ``split`` boxes."""
+    budget = job.max_boxes if budget is None else budget
+    m, done, count = job.m, [], 0
+    while frontier.shape[0]:
+        if split is not None and frontier.shape[0] >= split:
+            break
+        y = _images(job.f, frontier, m)
+        m = y.shape[1]
+        empty = np.isnan(y.lo).any(axis=1)  # f is undefined on the whole box
+        wide = (y.max_diam() > job.eps) & ~empty & (frontier.max_diam() > 0)
+        ok = ~wide & ~empty
+        done.append(y[ok])
+        count += int(ok.sum())
+        if count + 2 * int(wide.sum()) > budget:
+            done.append(y[wide])
+            count += int(wide.sum())
+            frontier = frontier[:0]
+            break
+        left, right = frontier[wide].bisect()
+        frontier = Interval._new(np.concatenate([left.lo, right.lo]),
+                                 np.concatenate([left.hi, right.hi]))
+    return _Bisected(done, count, m, frontier)
