@@ -88,8 +88,8 @@ def run(args: argparse.Namespace) -> int:
     what = ("pure window observer" if args.window_only else "recursive observer") + (
         f", {args.sweeps} smoothing round(s) per ping" if args.sweeps else ", no smoothing") + (
         f", paving with {_sides((args.paving, args.paving_heading))}" if paved else "")
-    print(f"{what} ({'online, one update per ping' if args.online else 'offline'}); the "
-          "first run compiles its kernels (about a minute, once)", flush=True)
+    print(f"{what} ({'online, one update per ping' if args.online else 'offline'})",
+          flush=True)
     res, per_update = (_online(data, kw) if args.online else (solve_pool(data, **kw), None))
     p_full = binomial_bound(args.m, args.q, data.p_outlier)
     print(f"q = {args.q} outliers allowed in a window of m = {args.m} pings: "
