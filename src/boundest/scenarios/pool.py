@@ -66,11 +66,11 @@ def _eps(paving: float | None, heading: float | None) -> np.ndarray:
     return np.array([xy, xy, np.inf if heading is None else float(heading)])
 
 
-def _check(q: int, m: int, sweeps: int, passes: int) -> np.ndarray:
+def _check(q: int, m: int, sweeps: int, passes: int, carry: bool) -> np.ndarray:
     if m < 1 or q < 0 or sweeps < 0 or passes < 1:
         raise ValueError(f"need m >= 1, q >= 0, sweeps >= 0 and passes >= 1, got m={m}, "
                          f"q={q}, sweeps={sweeps}, passes={passes}")
-    return np.array([m, q, sweeps, passes, 0], dtype=np.int64)
+    return np.array([m, q, sweeps, passes, int(bool(carry))], dtype=np.int64)
 
 
 class PoolObserver:
@@ -110,9 +110,8 @@ class PoolObserver:
     def __init__(self, data: PoolData, q: int = 8, m: int = 80, sweeps: int = DEFAULT_SWEEPS,
                  passes: int = DEFAULT_PASSES, carry: bool = True,
                  paving: float | None = None, paving_heading: float | None = None) -> None:
-        self.par = _check(q, m, sweeps, passes)
+        self.par = _check(q, m, sweeps, passes, carry)
         self.eps = _eps(paving, paving_heading)
-        self.par[po.CARRY] = int(bool(carry))
         self.q, self.m = int(q), int(m)
         self.tapes = pack_tapes(data.map)
         self.x0 = data.x0
@@ -142,11 +141,10 @@ class PoolObserver:
             ul = np.ascontiguousarray(u.lo, dtype=np.float64).reshape(2)
             uh = np.ascontiguousarray(u.hi, dtype=np.float64).reshape(2)
         xl, xh = np.empty(4), np.empty(4)
-        rej, empty, self.cells_kept = po.observer_update(self.k, ul, uh, float(alpha), float(d.lo),
-                                           float(d.hi), self.par, self.eps, self.x0.lo,
-                                           self.x0.hi, self.restart.lo, self.restart.hi,
-                                           self.h[0], self.h[1], self.tapes, self.ring, xl, xh,
-                                           self.work, self.cells[0], self.cells[1])
+        rej, empty, self.cells_kept = po.observer_update(
+            self.k, ul, uh, float(alpha), float(d.lo), float(d.hi), self.par, self.eps,
+            self.x0.lo, self.x0.hi, self.restart.lo, self.restart.hi, self.h[0], self.h[1],
+            self.tapes, self.ring, xl, xh, self.work, self.cells[0], self.cells[1])
         self.k += 1
         return Interval._new(xl, xh), int(rej), bool(empty)
 
@@ -207,11 +205,10 @@ def solve_pool(data: PoolData, q: int = 8, m: int = 80, sweeps: int = DEFAULT_SW
     """Run the observer over the whole mission (or every mission of a batch) offline: the
     same updates as :class:`PoolObserver` (parameters there), all in one compiled call.
     With ``paving``, the first ``keep_cells`` kept cells of each step are returned."""
-    par = _check(q, m, sweeps, passes)
+    par = _check(q, m, sweeps, passes, carry)
     eps = _eps(paving, paving_heading)
     paved = bool(np.isfinite(eps).any())
     n_cells = keep_cells if paved else 0
-    par[po.CARRY] = int(bool(carry))
     start = time.perf_counter()
     tapes = pack_tapes(data.map)
     restart = restart_box(data)
