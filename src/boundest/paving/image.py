@@ -132,7 +132,7 @@ def pave(y: Interval, eps: float) -> Subpaving:
 
 def image(sp: Subpaving, f: Callable[[Interval], Interval], *, eps: float,
           max_boxes: int = 1_000_000, extra: Interval | None = None,
-          executor: Executor | None = None, split: int = 16384, tasks: int = 64,
+          executor: Executor | None = None, split: int = 16384, tasks: int = 16,
           progress: bool | None = None) -> Subpaving:
     """A subpaving guaranteed to contain ``f(V)``, ``V`` the inside and boundary boxes of ``sp``.
 

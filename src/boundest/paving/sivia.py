@@ -129,7 +129,7 @@ def sivia(box: Interval, *, test: Test | None = None, ctc_in: Contractor | None 
           y: Interval | None = None, eps: float = 1e-2, max_boxes: int | None = None,
           keep_outside: bool = False, variables: Sequence[str] | None = None,
           batch: int = 16384, executor: Executor | None = None, split: int = 16384,
-          tasks: int = 64, progress: bool | None = False) -> Subpaving:
+          tasks: int = 16, progress: bool | None = False) -> Subpaving:
     """Set inversion of ``{x in box : f(x) in y}`` by a subpaving.
 
     Parameters
@@ -166,7 +166,8 @@ def sivia(box: Interval, *, test: Test | None = None, ctc_in: Contractor | None 
         (a bound on the whole paving).
     split, tasks : int
         With an executor: the frontier size at which the work is cut, and into how many tasks
-        (a few per worker or more: the parts differ in size).
+        (a few per worker: the parts differ in size; but each part pays the batched loop's
+        fixed costs again, so cutting finer costs work: docs/distributed.md).
     progress : bool or None
         With an executor: a progress bar over the tasks (None: only on a terminal).
 
