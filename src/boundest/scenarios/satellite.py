@@ -60,7 +60,7 @@ X0_TRUE = (4.0, 0.5, -0.2, 0.5)
 #: Sign restrictions of Remark 2 on x(0).
 X0_DOMAINS = ((0.0, np.inf), (0.0, np.inf), (-np.inf, 0.0), (0.0, np.inf))
 #: The propagation modes of ``solve``, the default first: 3B shaving of the states after hull
-#: consistency, or hull consistency alone (about 50 times cheaper, 4 times wider in x1 at
+#: consistency, or hull consistency alone (about 45 times cheaper, 4 times wider in x1 at
 #: k_max = 200; benchmarks/README.md has the table).
 MODES = ("3b", "hc4")
 #: Shaving settings of the ``3b`` mode (``boundest.csp.propagate.Shaving``).
