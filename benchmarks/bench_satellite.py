@@ -5,6 +5,8 @@ For each data set it reports boundest's time to the fixed point of the satellite
 excluded), the median of ``--repeat`` runs after a warm-up run (the very first run in the process
 also loads or compiles the Numba kernels; it is reported as ``first_run_s``), evaluations, the
 mean width of each state component over k = 0..k_max and the enclosures of x(0) and x(k_max);
+in boundest's hull-consistency mode (``mode="hc4"``, what Codac computes too; the shaving mode,
+``boundest run satellite``'s default, is compared in ``bench_satellite_modes.py``);
 then the same for Codac 1.5.7 (``benchmarks/satellite_codac.py``, run as a subprocess with
 ``.bench-venv-codac1/bin/python``, because importing codac switches the FPU to rounding upward),
 with speed-ups (Codac time / boundest time) and width ratios (Codac / boundest).
@@ -121,12 +123,12 @@ def _datasets(sat: Any, seed: int, ks: list[int], same_data: bool) -> list[dict]
 def _bench_boundest(sat: Any, ds: dict, repeat: int, rel_eps: float) -> tuple[dict, Any]:
     meas, K = ds["meas"], ds["k_max"]
     t0 = time.perf_counter()
-    first = sat.solve(meas, rel_eps=rel_eps, progress=False)
+    first = sat.solve(meas, rel_eps=rel_eps, progress=False, mode="hc4")
     first_wall = time.perf_counter() - t0
     runs, walls = [], []
     for _ in range(repeat):
         t0 = time.perf_counter()
-        runs.append(sat.solve(meas, rel_eps=rel_eps, progress=False))
+        runs.append(sat.solve(meas, rel_eps=rel_eps, progress=False, mode="hc4"))
         walls.append(time.perf_counter() - t0)
     res = runs[-1]
     times = [r.time_s for r in runs]
@@ -172,8 +174,9 @@ def _flatness(sat: Any, seeds: list[int], k_long: int, repeat: int, rel_eps: flo
         rec: dict[str, Any] = {"seed": seed}
         for k in (200, k_long):
             meas = sat.Measurements(sim.y_lo[: k + 1], sim.y_hi[: k + 1], sim.source)
-            sat.solve(meas, rel_eps=rel_eps, progress=False)  # warm-up, model compilation
-            runs = [sat.solve(meas, rel_eps=rel_eps, progress=False) for _ in range(repeat)]
+            sat.solve(meas, rel_eps=rel_eps, progress=False, mode="hc4")  # warm-up, compilation
+            runs = [sat.solve(meas, rel_eps=rel_eps, progress=False, mode="hc4")
+                    for _ in range(repeat)]
             res = runs[-1]
             rec[f"t{k}_s"] = statistics.median(r.time_s for r in runs)
             rec[f"revisions_per_node_{k}"] = _r(res.iterations, 3)

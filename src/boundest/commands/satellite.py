@@ -20,7 +20,7 @@ def run(args: argparse.Namespace) -> int:
     print(f"satellite (Jaulin 2002): k_max = {meas.k_max}, data {meas.source}")
     print(f"CSP: {7 * (meas.k_max + 1)} constraints over {11 * meas.k_max + 15} variables; "
           "propagating ...", flush=True)
-    res = sat.solve(meas, rel_eps=args.rel_eps)
+    res = sat.solve(meas, rel_eps=args.rel_eps, mode=args.mode)
     if not res.consistent and args.beta_tuning:
         print("the CSP is empty: the data contradict the model; beta-tuning ...")
         bres, res = sat.tune(meas, rel_eps=args.rel_eps)
@@ -32,6 +32,13 @@ def run(args: argparse.Namespace) -> int:
     else:
         print(f"fixed point reached in {res.time_s:.3f} s ({res.evaluations} node revisions, "
               f"{res.iterations:.1f} passes equivalent)")
+        if res.shaving:
+            sh = res.shaving
+            print(f"  mode 3b: hull consistency, then shaving of the states "
+                  f"({sh['probes']} probes, {sh['refuted']} slices refuted, "
+                  f"{sh['time_s']:.3f} s; --mode hc4: hull consistency alone, faster, wider)")
+        else:
+            print(f"  mode {res.mode}: hull consistency alone (--mode 3b shaves: tighter)")
         for k in (0, meas.k_max):
             b = res.box(k)
             print(f"  x({k}) in " + " x ".join(f"[{lo:.4f}, {hi:.4f}]"
@@ -70,6 +77,10 @@ def register(runs: argparse._SubParsersAction) -> None:
     sat.add_argument("--rel-eps", type=float, default=1e-3,
                      help="propagation stops when no domain shrinks by more than this "
                           "fraction of its width (default 1e-3)")
+    sat.add_argument("--mode", choices=("3b", "hc4"), default="3b",
+                     help="3b (default): hull consistency, then 3B shaving of the states "
+                          "(tighter); hc4: hull consistency alone (faster); "
+                          "benchmarks/README.md compares them")
     sat.add_argument("--beta-tuning", action="store_true",
                      help="if the CSP is empty, search the smallest relaxation beta")
     sat.add_argument("--out", default="out", help="folder for figures (default: out)")

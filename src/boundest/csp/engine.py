@@ -1,4 +1,5 @@
-"""The compiled propagation kernel: AC3-style revisions of the primitive nodes of a tape.
+"""The compiled propagation kernels: AC3-style revisions of the primitive nodes of a tape, and
+3B shaving on top of them.
 
 Each node ``z = f(x, y)`` is revised by ``z ∩= f(x, y)`` then ``(x, y) = f_rev(z, x, y)``. When a
 slot's domain shrinks by more than ``rel_eps`` of its width (or loses an infinite bound), every
@@ -6,6 +7,11 @@ other node using that slot becomes dirty again. Dirty nodes are revised window b
 the tape order (the order of the constraints, i.e. of the time steps for a time series), in
 alternating forward and backward passes, so that the work per time step does not grow with the
 horizon.
+
+``shave_kernel`` adds 3B consistency (shaving): it cuts a slice off a bound of a slot, propagates
+the sliced network, and removes the slice when that propagation proves it empty. A probe only
+revises the windows its change reaches and undoes its own writes from a trail, so its cost does
+not depend on the size of the tape.
 """
 
 from __future__ import annotations
@@ -16,12 +22,17 @@ import numpy as np
 from ..ctc.revise import family_flags
 from ..ctc.revise import revise as _revise
 
-__all__ = ["DONE", "EMPTY", "RUNNING", "family_flags", "propagate_kernel"]
+__all__ = ["DONE", "EMPTY", "RUNNING", "SHAVE_STATS", "family_flags", "propagate_kernel",
+           "shave_kernel"]
 
 DONE, RUNNING, EMPTY = 0, 1, 2
 #: A window that has not settled after this many local sweeps hands its remaining dirty nodes
 #: to the next pass (a safeguard against slowly converging cycles; it never loses soundness).
 _LOCAL_SWEEPS = 64
+#: The counters ``shave_kernel`` writes into its ``stats`` argument, in this order.
+SHAVE_STATS = ("rounds", "probes", "refuted", "probe_evaluations", "evaluations")
+
+
 @nb.njit(cache=True, inline="always", error_model="numpy")
 def _significant(ol, oh, nl, nh, rel_eps):
     """Whether ``[ol, oh] -> [nl, nh]`` is a shrink worth propagating."""
@@ -33,12 +44,35 @@ def _significant(ol, oh, nl, nh, rel_eps):
     return (w0 - (nh - nl)) > rel_eps * w0
 
 
+@nb.njit(cache=True, inline="always", error_model="numpy")
+def _record(s, lo, hi, trail, tval, tpos):
+    """Push slot ``s``'s current domain on the trail (undone by ``_undo``)."""
+    p = tpos[0]
+    trail[p] = s
+    tval[2 * p] = lo[s]
+    tval[2 * p + 1] = hi[s]
+    tpos[0] = p + 1
+
+
 @nb.njit(cache=True, error_model="numpy")
-def _update(s, nl, nh, lo, hi, rel_eps):
-    """Intersect slot ``s`` with ``[nl, nh]``: -1 empty, 1 significant shrink, 0 otherwise."""
+def _undo(lo, hi, trail, tval, tpos):
+    """Restore every slot written since the trail was empty, newest write first."""
+    for p in range(tpos[0] - 1, -1, -1):
+        s = trail[p]
+        lo[s] = tval[2 * p]
+        hi[s] = tval[2 * p + 1]
+    tpos[0] = 0
+
+
+@nb.njit(cache=True, inline="always", error_model="numpy")
+def _update(s, nl, nh, lo, hi, rel_eps, trail, tval, tpos):
+    """Intersect slot ``s`` with ``[nl, nh]``: -1 empty, 1 significant shrink, 0 otherwise.
+    With a trail (``trail is not None``) the old domain is recorded before it changes."""
     ol, oh = lo[s], hi[s]
     nl = max(nl, ol) if nl == nl else nl  # NaN (empty) must survive the max
     nh = min(nh, oh) if nh == nh else nh
+    if trail is not None and not (nl == ol and nh == oh):
+        _record(s, lo, hi, trail, tval, tpos)
     if nl != nl or nh != nh or nl > nh:
         lo[s] = np.nan
         hi[s] = np.nan
@@ -50,8 +84,23 @@ def _update(s, nl, nh, lo, hi, rel_eps):
 
 
 @nb.njit(cache=True, inline="always", error_model="numpy")
-def _revise_node(i, op, out, a, b, param, lo, hi, ptr, adj, dirty, pending, window, rel_eps,
-                 buf, changed, piecewise, pown, explog, trig):
+def _mark(j, dirty, pending, span, window):
+    """Make node ``j`` dirty (1 if it was not, else 0), widening the span of dirty windows."""
+    if dirty[j]:
+        return 0
+    dirty[j] = True
+    w = j // window
+    pending[w] += 1
+    if w < span[0]:
+        span[0] = w
+    if w > span[1]:
+        span[1] = w
+    return 1
+
+
+@nb.njit(cache=True, inline="always", error_model="numpy")
+def _revise_node(i, op, out, a, b, param, lo, hi, ptr, adj, dirty, pending, span, window,
+                 rel_eps, buf, changed, trail, tval, tpos, piecewise, pown, explog, trig):
     """Revise node ``i`` and mark the nodes whose slots it shrank significantly. Returns the
     number of nodes newly marked dirty, or -1 when a domain became empty."""
     o, ia, ib = out[i], a[i], b[i]
@@ -63,20 +112,20 @@ def _revise_node(i, op, out, a, b, param, lo, hi, ptr, adj, dirty, pending, wind
                                        piecewise, pown, explog, trig)
     # when o aliases an argument, each update is still a sound intersection
     nch = 0
-    r = _update(o, zl, zh, lo, hi, rel_eps)
+    r = _update(o, zl, zh, lo, hi, rel_eps, trail, tval, tpos)
     if r < 0:
         return -1
     if r > 0:
         changed[nch] = o
         nch += 1
-    r = _update(ia, xl, xh, lo, hi, rel_eps)
+    r = _update(ia, xl, xh, lo, hi, rel_eps, trail, tval, tpos)
     if r < 0:
         return -1
     if r > 0:
         changed[nch] = ia
         nch += 1
     if ib >= 0:
-        r = _update(ib, yl, yh, lo, hi, rel_eps)
+        r = _update(ib, yl, yh, lo, hi, rel_eps, trail, tval, tpos)
         if r < 0:
             return -1
         if r > 0:
@@ -87,11 +136,38 @@ def _revise_node(i, op, out, a, b, param, lo, hi, ptr, adj, dirty, pending, wind
         s = changed[c]
         for k in range(ptr[s], ptr[s + 1]):
             j = adj[k]
-            if (j != i or again) and not dirty[j]:
-                dirty[j] = True
-                pending[j // window] += 1
-                added += 1
+            if j != i or again:
+                added += _mark(j, dirty, pending, span, window)
     return added
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _settle(w, d, op, out, a, b, param, lo, hi, ptr, adj, dirty, pending, span, window,
+            rel_eps, buf, changed, cnt, max_evals, trail, tval, tpos, piecewise, pown, explog,
+            trig):
+    """Bring window ``w`` to its local fixed point by alternating sweeps (the first in direction
+    ``d``), until ``cnt[1]`` (revisions) reaches ``max_evals``. ``cnt = [dirty count,
+    revisions]`` is updated. Returns False when a domain became empty."""
+    first, last = w * window, min((w + 1) * window, op.size)
+    sweeps = 0
+    while pending[w] > 0 and sweeps < _LOCAL_SWEEPS and cnt[1] < max_evals:
+        sweeps += 1
+        i = first if d > 0 else last - 1
+        while first <= i < last and cnt[1] < max_evals:
+            if dirty[i]:
+                dirty[i] = False
+                pending[w] -= 1
+                cnt[0] -= 1
+                cnt[1] += 1
+                r = _revise_node(i, op, out, a, b, param, lo, hi, ptr, adj, dirty, pending,
+                                 span, window, rel_eps, buf, changed, trail, tval, tpos,
+                                 piecewise, pown, explog, trig)
+                if r < 0:
+                    return False
+                cnt[0] += r
+            i += d
+        d = -d
+    return True
 
 
 @nb.njit(cache=True, error_model="numpy")
@@ -117,41 +193,188 @@ def propagate_kernel(op, out, a, b, param, lo, hi, ptr, adj, dirty, state, rel_e
     for i in range(n):
         if dirty[i]:
             pending[i // window] += 1
-    wpos, count, evals, direction = state[0], state[1], 0, state[4]
+    span = np.array([0, nw - 1], dtype=np.int64)  # every window is visited by a pass
+    cnt = np.array([state[1], 0], dtype=np.int64)
+    wpos, direction = state[0], state[4]
     buf = np.empty(4)
     changed = np.empty(3, dtype=np.int64)
+    tpos = np.zeros(1, dtype=np.int64)
     status = RUNNING
-    while count > 0 and evals < max_evals and status == RUNNING:
+    while cnt[0] > 0 and cnt[1] < max_evals:
         if wpos >= nw:  # end of a pass: turn round
             wpos = 0
             direction = -direction
         w = wpos if direction > 0 else nw - 1 - wpos
         wpos += 1
-        first, last = w * window, min((w + 1) * window, n)
-        d = direction
-        sweeps = 0
-        while pending[w] > 0 and sweeps < _LOCAL_SWEEPS and evals < max_evals:
-            sweeps += 1
-            i = first if d > 0 else last - 1
-            while first <= i < last and evals < max_evals:
-                if dirty[i]:
-                    dirty[i] = False
-                    pending[w] -= 1
-                    count -= 1
-                    evals += 1
-                    r = _revise_node(i, op, out, a, b, param, lo, hi, ptr, adj, dirty, pending,
-                                     window, rel_eps, buf, changed, piecewise, pown,
-                                     explog, trig)
-                    if r < 0:
-                        status = EMPTY
-                        break
-                    count += r
-                i += d
-            if status == EMPTY:
-                break
-            d = -d
-    if status != EMPTY and count == 0:
+        if not _settle(w, direction, op, out, a, b, param, lo, hi, ptr, adj, dirty, pending,
+                       span, window, rel_eps, buf, changed, cnt, max_evals, None, None, tpos,
+                       piecewise, pown, explog, trig):
+            status = EMPTY
+            break
+    if status != EMPTY and cnt[0] == 0:
         status = DONE
-    state[0], state[1], state[2], state[3], state[4] = wpos, count, status, state[3] + evals, \
+    state[0], state[1], state[2], state[3], state[4] = wpos, cnt[0], status, state[3] + cnt[1], \
         direction
     return status
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _drain(op, out, a, b, param, lo, hi, ptr, adj, dirty, pending, span, window, rel_eps, buf,
+           changed, cnt, max_evals, trail, tval, tpos, piecewise, pown, explog, trig):
+    """Revise the dirty nodes in alternating passes over the span of dirty windows only (it
+    grows as changes spread and is trimmed between passes), until none is dirty or ``cnt[1]``
+    reaches ``max_evals``. Returns False when a domain became empty."""
+    d = 1
+    while cnt[0] > 0 and cnt[1] < max_evals:
+        w = span[0] if d > 0 else span[1]
+        while span[0] <= w <= span[1] and cnt[1] < max_evals:
+            if pending[w] > 0 and not _settle(w, d, op, out, a, b, param, lo, hi, ptr, adj,
+                                              dirty, pending, span, window, rel_eps, buf,
+                                              changed, cnt, max_evals, trail, tval, tpos,
+                                              piecewise, pown, explog, trig):
+                return False
+            w += d
+        d = -d
+        while span[0] < span[1] and pending[span[0]] == 0:
+            span[0] += 1
+        while span[1] > span[0] and pending[span[1]] == 0:
+            span[1] -= 1
+    return True
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _forget(dirty, pending, span, window, cnt):
+    """Clear the dirty nodes a drain left (they all lie in the span), and reset the span."""
+    n = dirty.size
+    for w in range(span[0], span[1] + 1):
+        if pending[w] > 0:
+            for i in range(w * window, min((w + 1) * window, n)):
+                dirty[i] = False
+            pending[w] = 0
+    cnt[0] = 0
+    span[0] = pending.size
+    span[1] = -1
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _touch(s, ptr, adj, dirty, pending, span, window, cnt):
+    """Mark every node using slot ``s`` dirty."""
+    for k in range(ptr[s], ptr[s + 1]):
+        cnt[0] += _mark(adj[k], dirty, pending, span, window)
+
+
+@nb.njit(cache=True, error_model="numpy")
+def shave_kernel(op, out, a, b, param, lo, hi, ptr, adj, cand, rel_eps, probe_eps, probe_evals,
+                 frac, max_rounds, reach, min_gain, window, stats, piecewise=None, pown=None,
+                 explog=None, trig=None):
+    """3B consistency by shaving, with an adaptive (ACID-like) choice of what to shave.
+
+    First the whole tape is propagated to its fixed point (hull consistency). Then, round by
+    round, for each candidate slot ``cand[j]`` still active (in ``cand`` order, then in reverse
+    order on the next round) and each of its bounds: the slice ``[lo, lo + f w]`` (or
+    ``[hi - f w, hi]``, ``w`` the slot's width) is imposed and propagated, at tolerance
+    ``probe_eps`` and for at most ``probe_evals`` revisions; when that proves the sliced network
+    empty, no solution lies in the slice, the bound moves to the cut, the change is propagated to
+    the fixed point at ``rel_eps``, and the next slice, twice as wide (``f`` doubles, up to 1/2),
+    is tried; the first slice not refuted ends that bound. A candidate stays active in the next
+    round only when it or one within ``reach`` positions of it in ``cand`` lost more than
+    ``min_gain`` of its width in this round; the rounds stop when none did, or after
+    ``max_rounds``.
+
+    A probe revises only the windows its change reaches and undoes its writes from a trail, so
+    its cost depends on how far its change travels, not on the length of the tape. Every
+    contraction is either hull consistency or the removal of a slice proven empty: no solution
+    is lost. ``stats`` receives the counters named in :data:`SHAVE_STATS`. Returns DONE, or
+    EMPTY when the network was proven to have no solution.
+    """
+    n = op.size
+    nw = (n + window - 1) // window
+    m = cand.size
+    dirty = np.ones(n, dtype=np.bool_)
+    pending = np.zeros(nw, dtype=np.int64)
+    for i in range(n):
+        pending[i // window] += 1
+    span = np.array([0, nw - 1], dtype=np.int64)
+    cnt = np.array([n, 0], dtype=np.int64)
+    buf = np.empty(4)
+    changed = np.empty(3, dtype=np.int64)
+    cap = 3 * probe_evals + 3
+    trail = np.empty(cap, dtype=np.int64)
+    tval = np.empty(2 * cap)
+    tpos = np.zeros(1, dtype=np.int64)
+    big = np.iinfo(np.int64).max
+    for k in range(stats.size):
+        stats[k] = 0
+    if not _drain(op, out, a, b, param, lo, hi, ptr, adj, dirty, pending, span, window, rel_eps,
+                  buf, changed, cnt, big, None, None, tpos, piecewise, pown, explog, trig):
+        stats[4] = cnt[1]
+        return EMPTY
+    total = cnt[1]
+    _forget(dirty, pending, span, window, cnt)
+    active = np.ones(m, dtype=np.bool_)
+    gained = np.zeros(m, dtype=np.bool_)
+    for rnd in range(max_rounds):
+        stats[0] += 1
+        for jj in range(m):
+            j = jj if rnd % 2 == 0 else m - 1 - jj
+            gained[j] = False
+            if not active[j]:
+                continue
+            s = cand[j]
+            w0 = hi[s] - lo[s]
+            for side in range(2):
+                f = frac
+                while True:
+                    l, h = lo[s], hi[s]
+                    cut = l + f * (h - l) if side == 0 else h - f * (h - l)
+                    if not (l < cut < h):  # a point, an unbounded or too thin a domain
+                        break
+                    # probe: the slice alone, propagated on a trail, then undone
+                    _record(s, lo, hi, trail, tval, tpos)
+                    if side == 0:
+                        hi[s] = cut
+                    else:
+                        lo[s] = cut
+                    _touch(s, ptr, adj, dirty, pending, span, window, cnt)
+                    cnt[1] = 0
+                    ok = _drain(op, out, a, b, param, lo, hi, ptr, adj, dirty, pending, span,
+                                window, probe_eps, buf, changed, cnt, probe_evals, trail, tval,
+                                tpos, piecewise, pown, explog, trig)
+                    stats[1] += 1
+                    stats[3] += cnt[1]
+                    total += cnt[1]
+                    _forget(dirty, pending, span, window, cnt)
+                    _undo(lo, hi, trail, tval, tpos)
+                    if ok:
+                        break
+                    # the slice holds no solution: cut it off and propagate for good
+                    stats[2] += 1
+                    if side == 0:
+                        lo[s] = cut
+                    else:
+                        hi[s] = cut
+                    _touch(s, ptr, adj, dirty, pending, span, window, cnt)
+                    cnt[1] = 0
+                    ok = _drain(op, out, a, b, param, lo, hi, ptr, adj, dirty, pending, span,
+                                window, rel_eps, buf, changed, cnt, big, None, None, tpos,
+                                piecewise, pown, explog, trig)
+                    total += cnt[1]
+                    if not ok:
+                        stats[4] = total
+                        return EMPTY
+                    _forget(dirty, pending, span, window, cnt)
+                    f = min(2.0 * f, 0.5)
+            w1 = hi[s] - lo[s]
+            gained[j] = w0 > 0 and w1 < w0 and (w0 == np.inf or w0 - w1 > min_gain * w0)
+        anyg = False
+        for j in range(m):
+            active[j] = False
+            anyg |= gained[j]
+        if not anyg:
+            break
+        for j in range(m):
+            if gained[j]:
+                for q in range(max(0, j - reach), min(m, j + reach + 1)):
+                    active[q] = True
+    stats[4] = total
+    return DONE

@@ -1,4 +1,5 @@
-"""Propagation of a CSP to a fixed point (hull consistency on its primitive decomposition)."""
+"""Propagation of a CSP to a fixed point: hull consistency on its primitive decomposition
+(``mode="hc4"``), or 3B consistency by shaving on top of it (``mode="3b"``)."""
 
 from __future__ import annotations
 
@@ -11,9 +12,56 @@ from ..expr.model import Model
 from ..expr.nodes import Constraint
 from ..expr.tape import Tape, compile_model
 from ..interval import Interval
-from .engine import EMPTY, RUNNING, family_flags, propagate_kernel
+from .engine import EMPTY, RUNNING, SHAVE_STATS, family_flags, propagate_kernel, shave_kernel
 
-__all__ = ["Propagation", "propagate", "slot_users"]
+__all__ = ["MODES", "Propagation", "Shaving", "propagate", "slot_users"]
+
+#: The propagation modes: hull consistency alone, or 3B shaving after it.
+MODES = ("hc4", "3b")
+
+
+@dataclass(frozen=True)
+class Shaving:
+    """Settings of 3B shaving (``propagate(mode="3b")``; ``engine.shave_kernel`` details them).
+
+    Attributes
+    ----------
+    frac : float
+        First slice of a bound, as a fraction of the domain's width (it doubles, up to 1/2,
+        after each slice refuted).
+    probe_eps : float
+        Tolerance of a probe's propagation (coarser than the fixed point's ``rel_eps``: a probe
+        only has to find an empty domain).
+    probe_evals : int
+        Node revisions a probe may spend before its slice counts as not refuted (what bounds
+        the reach, and so the cost, of a probe).
+    rounds : int
+        Rounds over the candidates at most.
+    reach : int
+        A candidate is shaved again in the next round when it or one within ``reach``
+        positions of it (in the candidate order) lost more than ``min_gain`` of its width
+        (ACID-like: shave where it recently paid).
+    min_gain : float
+        Relative width a candidate must lose in a round for the round to count as paying.
+    """
+
+    frac: float = 0.1
+    probe_eps: float = 1e-2
+    probe_evals: int = 500
+    rounds: int = 2
+    reach: int = 12
+    min_gain: float = 0.05
+
+    def __post_init__(self) -> None:
+        if not 0.0 < self.frac <= 0.5:
+            raise ValueError(f"frac must lie in ]0, 1/2], got {self.frac}")
+        if not 0.0 <= self.probe_eps < 1.0:
+            raise ValueError(f"probe_eps must lie in [0, 1[, got {self.probe_eps}")
+        for name in ("probe_evals", "rounds"):
+            if getattr(self, name) < 1:
+                raise ValueError(f"{name} must be at least 1, got {getattr(self, name)}")
+        if self.reach < 0 or self.min_gain < 0:
+            raise ValueError("reach and min_gain must be non-negative")
 
 
 @dataclass
@@ -32,6 +80,12 @@ class Propagation:
         ``evaluations / n_nodes``: the work in units of full passes over the tape.
     time_s : float
         Wall time of the propagation (compilation of the model excluded).
+    mode : str
+        ``"hc4"`` or ``"3b"`` (see ``propagate``).
+    shaving : dict
+        With ``mode="3b"``: the counters of the shaving phase (``engine.SHAVE_STATS``: rounds,
+        probes, slices refuted, revisions spent in probes, revisions in all) and its time
+        ``time_s`` (included in the propagation's ``time_s``); empty otherwise.
     """
 
     domains: dict[str, Interval]
@@ -42,6 +96,8 @@ class Propagation:
     n_nodes: int
     n_slots: int
     slots: Interval = field(repr=False)
+    mode: str = "hc4"
+    shaving: dict = field(default_factory=dict)
 
     def __getitem__(self, name: str) -> Interval:
         return self.domains[name]
@@ -54,7 +110,7 @@ class Propagation:
         return (f"Propagation(consistent={self.consistent}, variables={len(doms)}, "
                 f"empty={empty}, unbounded={unbounded}, evaluations={self.evaluations}, "
                 f"iterations={self.iterations:.3g}, time_s={self.time_s:.3g}, "
-                f"n_nodes={self.n_nodes}, n_slots={self.n_slots})")
+                f"n_nodes={self.n_nodes}, n_slots={self.n_slots}, mode={self.mode!r})")
 
 
 def slot_users(tape: Tape) -> tuple[np.ndarray, np.ndarray]:
@@ -76,9 +132,19 @@ def slot_users(tape: Tape) -> tuple[np.ndarray, np.ndarray]:
 
 def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
               max_evaluations: int | None = None, domains: dict[str, Interval] | None = None,
-              progress: bool | None = None, chunk: int = 2_000_000, window: int = 64
-              ) -> Propagation:
+              progress: bool | None = None, chunk: int = 2_000_000, window: int = 64,
+              mode: str = "hc4", shave: list[str] | None = None,
+              shaving: Shaving | None = None) -> Propagation:
     """Contract all domains of a CSP to a fixed point.
+
+    ``mode="hc4"`` is hull consistency: every primitive node revised until nothing moves.
+    ``mode="3b"`` then shaves (3B consistency, adaptive): for each variable of ``shave`` and
+    each of its bounds, a slice at the bound is propagated alone, and removed when that proves
+    it holds no solution (``engine.shave_kernel``). Each probe is local (it revises only what
+    its slice reaches, within ``shaving.probe_evals`` revisions, and undoes itself from a
+    trail), so the cost per variable does not grow with the size of the CSP. It is tighter
+    where hull consistency suffers from the dependency problem or from the locality of its
+    constraints (a variable that occurs several times, a sign that only the next steps decide).
 
     Stopping rule: a node is revised again only when one of its slots shrank by more than
     ``rel_eps`` times its width (or lost an infinite bound); propagation stops when no such
@@ -103,7 +169,16 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
         Consecutive tape nodes brought to their local fixed point together before a pass moves
         on (see ``engine.propagate_kernel``); 64 nodes is about three time steps of the
         satellite.
+    mode : {"hc4", "3b"}
+        Hull consistency alone, or followed by shaving.
+    shave : list of str, optional
+        With ``mode="3b"``: the variables to shave, in the order they are visited (for a time
+        series, by time step; default: every variable of the model in its order).
+    shaving : Shaving, optional
+        With ``mode="3b"``: the shaving settings (default ``Shaving()``).
     """
+    if mode not in MODES:
+        raise ValueError(f"mode must be one of {', '.join(MODES)}, got {mode!r}")
     if not 0.0 <= rel_eps < 1.0:
         raise ValueError(f"rel_eps must lie in [0, 1[, got {rel_eps}")
     if window < 1:
@@ -128,6 +203,11 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
     # a zero-budget call compiles (first use) or loads the kernel outside the timed part
     propagate_kernel(tape.op, tape.out, tape.a, tape.b, tape.param, lo, hi, ptr, adj, dirty,
                      state.copy(), rel_eps, 0, window, *families)
+    if mode == "3b":  # the same for the shaving kernel, on an empty tape of the same types
+        e = slice(0, 0)
+        shave_kernel(tape.op[e], tape.out[e], tape.a[e], tape.b[e], tape.param[e], lo[e], hi[e],
+                     ptr[:1], adj[e], np.zeros(0, dtype=np.int64), rel_eps, rel_eps, 1, 0.5, 1,
+                     0, 0.0, window, np.zeros(len(SHAVE_STATS), dtype=np.int64), *families)
     t0 = time.perf_counter()
     status = EMPTY if np.isnan(lo).any() or (lo > hi).any() else RUNNING
     bar = None
@@ -147,12 +227,39 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
             bar.set_postfix(dirty=int(state[1]))
     if bar is not None:
         bar.close()
+    evaluations = int(state[3])
+    shave_info: dict = {}
+    if mode == "3b" and status != EMPTY and n > 0:
+        cand = _shave_slots(tape, shave)
+        opts = shaving or Shaving()
+        stats = np.zeros(len(SHAVE_STATS), dtype=np.int64)
+        t1 = time.perf_counter()
+        status = shave_kernel(tape.op, tape.out, tape.a, tape.b, tape.param, lo, hi, ptr, adj,
+                              cand, rel_eps, float(opts.probe_eps), int(opts.probe_evals),
+                              float(opts.frac), int(opts.rounds), int(opts.reach),
+                              float(opts.min_gain), window, stats, *families)
+        shave_info = {k: int(v) for k, v in zip(SHAVE_STATS, stats, strict=True)}
+        shave_info["time_s"] = time.perf_counter() - t1
+        evaluations += int(stats[-1])
     elapsed = time.perf_counter() - t0
     consistent = status != EMPTY
     if not consistent:
         lo[:] = np.nan
         hi[:] = np.nan
     doms = {name: Interval._new(lo[s], hi[s]) for name, s in tape.slot_of.items()}
-    return Propagation(domains=doms, consistent=consistent, evaluations=int(state[3]),
-                       iterations=float(state[3]) / max(n, 1), time_s=elapsed, n_nodes=n,
-                       n_slots=tape.n_slots, slots=Interval._new(lo, hi))
+    return Propagation(domains=doms, consistent=consistent, evaluations=evaluations,
+                       iterations=evaluations / max(n, 1), time_s=elapsed, n_nodes=n,
+                       n_slots=tape.n_slots, slots=Interval._new(lo, hi), mode=mode,
+                       shaving=shave_info)
+
+
+def _shave_slots(tape: Tape, names: list[str] | None) -> np.ndarray:
+    """The slots of the variables ``names`` (default: all), each once, in that order."""
+    if names is None:
+        names = list(tape.slot_of)
+    unknown = [v for v in names if v not in tape.slot_of]
+    if unknown:
+        raise ValueError(f"unknown variable {unknown[0]!r} in shave")
+    slots = np.array([tape.slot_of[v] for v in names], dtype=np.int64)
+    _, first = np.unique(slots, return_index=True)
+    return slots[np.sort(first)]
