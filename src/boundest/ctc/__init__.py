@@ -1,11 +1,13 @@
 """Contractors: forward-backward on a tape, composition, fixpoint, inflation, q-relaxed
-intersection; the range sensor (first-hit distance along a ray of an obstacle map)."""
+intersection; LP contraction of linear / log-linear sub-networks; the range sensor (first-hit
+distance along a ray of an obstacle map)."""
 
 from .base import Contractor, Fixpoint, FunctionContractor, Inflate, Sequence, Union, shrink_ratio
 from .fwdbwd import CtcFwdBwd
+from .linear import CtcLinear
 from .obstacles import ObstacleMap
 from .qinter import CtcQInter
 from .raycast import CtcRayCast
 
-__all__ = ["Contractor", "CtcFwdBwd", "CtcQInter", "CtcRayCast", "Fixpoint", "FunctionContractor",
-           "Inflate", "ObstacleMap", "Sequence", "Union", "shrink_ratio"]
+__all__ = ["Contractor", "CtcFwdBwd", "CtcLinear", "CtcQInter", "CtcRayCast", "Fixpoint",
+           "FunctionContractor", "Inflate", "ObstacleMap", "Sequence", "Union", "shrink_ratio"]
