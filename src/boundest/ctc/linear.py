@@ -101,33 +101,45 @@ class LinearSystem:
                             self.b_lo[keep_rows], self.b_hi[keep_rows], self.n_cols)
 
 
-def _pairwise_sum(x: Interval) -> Interval:
-    """The interval sum along the last axis (pairwise; each addition rounded outward)."""
-    while x.shape[-1] > 1:
-        n = x.shape[-1]
-        half = n // 2
-        s = x[..., :half] + x[..., half:2 * half]
-        x = Interval._new(np.concatenate([s.lo, x.lo[..., 2 * half:]], axis=-1),
-                          np.concatenate([s.hi, x.hi[..., 2 * half:]], axis=-1))
-    if x.shape[-1] == 0:
-        return Interval(np.zeros(x.shape[:-1]))
-    return x[..., 0]
+_U = 2.0**-53  # unit roundoff of float64
+
+
+def _segment_sum(lo: NDArray[np.float64], hi: NDArray[np.float64], seg: NDArray[np.int64],
+                 n: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Enclosures of the sums of the intervals ``[lo_i, hi_i]`` grouped by ``seg`` (``n``
+    groups), rounded outward.
+
+    The float sums (``np.bincount``, a recursive summation) are widened by Higham's bound on
+    recursive summation, ``|fl(sum) - sum| <= gamma_(k-1) sum |p_i|`` with
+    ``gamma_k = k u / (1 - k u)`` for ``k`` terms; ``sum |p_i|`` is itself computed in float
+    and taken ``(1 + gamma_k)`` larger, and every step of the widening is rounded outward
+    (additions in gradual underflow are exact, so no underflow term is needed). Where the
+    bound is zero (one term, or all terms zero) the float sum is exact and kept as it is:
+    a zero reduced cost of a free variable must stay exactly zero. Infinite
+    terms give an infinite sum on their side; ``-inf + inf`` in a bound's sum cannot happen
+    (a lower bound is never ``+inf``).
+    """
+    k = np.maximum(np.bincount(seg, minlength=n).astype(np.float64) - 1.0, 0.0)
+    gamma = np.nextafter(k * _U / (1.0 - k * _U), np.inf)
+    gamma = np.where(k > 0, np.nextafter(gamma * (1.0 + gamma) * (1.0 + 4 * _U), np.inf), 0.0)
+    out = []
+    for v, side in ((lo, -np.inf), (hi, np.inf)):
+        fin = np.isfinite(v)
+        sv = np.bincount(seg, weights=np.where(fin, v, 0.0), minlength=n)
+        sa = np.bincount(seg, weights=np.where(fin, np.abs(v), 0.0), minlength=n)
+        err = gamma * sa
+        err = np.where(err > 0, np.nextafter(err, np.inf), 0.0)
+        r = np.where(err > 0, np.nextafter(sv + err if side > 0 else sv - err, side), sv)
+        inf = np.bincount(seg, weights=(~fin).astype(np.float64), minlength=n) > 0
+        out.append(np.where(inf, side, r))
+    return out[0], out[1]
 
 
 def _column_sums(system: LinearSystem, y: NDArray[np.float64]) -> Interval:
     """``[A]^T y`` in interval arithmetic, shape ``(n_cols,)``."""
     prod = Interval._new(system.a_lo, system.a_hi) * Interval(y[system.rows])
-    order = np.argsort(system.cols, kind="stable")
-    cols = system.cols[order]
-    counts = np.bincount(cols, minlength=system.n_cols)
-    width = int(counts.max()) if counts.size and system.cols.size else 0
-    lo = np.zeros((system.n_cols, max(width, 1)))
-    hi = np.zeros_like(lo)
-    start = np.concatenate([[0], np.cumsum(counts)[:-1]])
-    pos = np.arange(cols.size) - start[cols]
-    lo[cols, pos] = prod.lo[order]
-    hi[cols, pos] = prod.hi[order]
-    return _pairwise_sum(Interval._new(lo, hi))
+    lo, hi = _segment_sum(prod.lo, prod.hi, system.cols, system.n_cols)
+    return Interval._new(lo, hi)
 
 
 def safe_lower_bound(system: LinearSystem, c: NDArray[np.float64], y: NDArray[np.float64],
@@ -153,10 +165,11 @@ def safe_lower_bound(system: LinearSystem, c: NDArray[np.float64], y: NDArray[np
     r = Interval(np.asarray(c, dtype=np.float64)) - _column_sums(system, y)
     terms_x = r * Interval._new(lo, hi)
     terms_b = Interval(y) * Interval._new(system.b_lo, system.b_hi)
-    total = _pairwise_sum(Interval._new(np.concatenate([terms_x.lo, terms_b.lo]),
-                                        np.concatenate([terms_x.hi, terms_b.hi])))
-    v = float(total.lo)
-    return -np.inf if v != v else v
+    lo_terms = np.concatenate([terms_x.lo, terms_b.lo])
+    if np.isnan(lo_terms).any():
+        return -np.inf
+    total, _ = _segment_sum(lo_terms, lo_terms, np.zeros(lo_terms.size, dtype=np.int64), 1)
+    return float(total[0])
 
 
 def _solve(system: LinearSystem, A, c: NDArray[np.float64], lo: NDArray[np.float64],
@@ -192,6 +205,69 @@ def _solve(system: LinearSystem, A, c: NDArray[np.float64], lo: NDArray[np.float
     return 0, y
 
 
+class _Solver:
+    """``min c^T x`` over one system for many objectives and boxes: a HiGHS instance kept
+    between calls (each solve starts from the previous basis), through SciPy's bundled HiGHS
+    bindings; ``scipy.optimize.linprog(method="highs")`` where those are not available.
+    Returns rigorous lower bounds only (``bound``)."""
+
+    def __init__(self, system: LinearSystem, A=None) -> None:
+        self.system = system
+        self.A = system.mid_csr() if A is None else A
+        self.highs = None
+        try:
+            from scipy.optimize._highspy import _core as hc
+        except ImportError:  # pragma: no cover - older or newer SciPy: the public API
+            _linprog()
+            return
+        self.hc = hc
+        h = hc._Highs()
+        h.setOptionValue("output_flag", False)
+        lp = hc.HighsLp()
+        lp.num_col_, lp.num_row_ = system.n_cols, system.n_rows
+        lp.col_cost_ = np.zeros(system.n_cols)
+        lp.col_lower_ = np.full(system.n_cols, -np.inf)
+        lp.col_upper_ = np.full(system.n_cols, np.inf)
+        lp.row_lower_, lp.row_upper_ = system.b_lo.copy(), system.b_hi.copy()
+        csc = self.A.tocsc()
+        lp.a_matrix_.format_ = hc.MatrixFormat.kColwise
+        lp.a_matrix_.start_ = csc.indptr.astype(np.int32)
+        lp.a_matrix_.index_ = csc.indices.astype(np.int32)
+        lp.a_matrix_.value_ = csc.data.astype(np.float64)
+        if h.passModel(lp) != hc.HighsStatus.kOk:  # pragma: no cover - malformed model
+            raise RuntimeError("HiGHS rejected the LP")
+        self.highs = h
+        self.idx = np.arange(system.n_cols, dtype=np.int32)
+        self.solves = 0
+
+    def bound(self, c: NDArray[np.float64], lo: NDArray[np.float64],
+              hi: NDArray[np.float64]) -> float:
+        """A rigorous lower bound of ``c^T x`` (``+inf``: proven infeasible; ``-inf``: none)."""
+        if self.highs is None:
+            return _linprog_bound(self.system, self.A, c, lo, hi)
+        h, hc, n = self.highs, self.hc, self.system.n_cols
+        self.solves += 1
+        h.changeColsCost(n, self.idx, np.asarray(c, dtype=np.float64))
+        h.changeColsBounds(n, self.idx, lo, hi)
+        if h.run() == hc.HighsStatus.kError:
+            return -np.inf
+        status = h.getModelStatus()
+        if status == hc.HighsModelStatus.kOptimal:
+            y = np.asarray(h.getSolution().row_dual, dtype=np.float64)
+            return safe_lower_bound(self.system, c, y, lo, hi)
+        if status == hc.HighsModelStatus.kInfeasible:
+            _, has_ray, ray = h.getDualRay()
+            zero = np.zeros(n)
+            if has_ray:
+                ray = np.asarray(ray, dtype=np.float64)
+                for y in (ray, -ray):  # a Farkas certificate, checked in interval arithmetic
+                    if safe_lower_bound(self.system, zero, y, lo, hi) > 0.0:
+                        return np.inf
+            if infeasible(self.system, lo, hi, self.A):
+                return np.inf
+        return -np.inf
+
+
 def lp_bound(system: LinearSystem, c: NDArray[np.float64], lo: NDArray[np.float64],
              hi: NDArray[np.float64], A=None) -> float:
     """A rigorous lower bound of ``min c^T x`` over the rows and the box.
@@ -199,7 +275,12 @@ def lp_bound(system: LinearSystem, c: NDArray[np.float64], lo: NDArray[np.float6
     ``+inf`` only when infeasibility is *proven* (Farkas certificate); ``-inf`` when no
     useful bound was found (unbounded LP, solver failure, an infinite box bound in the way).
     """
-    A = system.mid_csr() if A is None else A
+    return _Solver(system, A).bound(np.asarray(c, dtype=np.float64), lo, hi)
+
+
+def _linprog_bound(system: LinearSystem, A, c: NDArray[np.float64], lo: NDArray[np.float64],
+                   hi: NDArray[np.float64]) -> float:
+    """``lp_bound`` through ``scipy.optimize.linprog(method="highs")``."""
     status, y = _solve(system, A, np.asarray(c, dtype=np.float64), lo, hi)
     if status == 0:
         return safe_lower_bound(system, c, y, lo, hi)
@@ -403,15 +484,20 @@ def extract(tape: Tape, lo: NDArray[np.float64], hi: NDArray[np.float64],
 
 # --- the contractor ------------------------------------------------------------------------
 
-def _local(system: LinearSystem, j: int, radius: int | None
-           ) -> tuple[LinearSystem, NDArray[np.int64]]:
-    """The rows within ``radius`` row-steps of column ``j`` (all rows reachable for None),
-    on the columns they use: ``(sub-system, its columns' indices in system)``."""
+def _incidence(system: LinearSystem):
+    """The row-column incidence matrix (CSR) and its transpose."""
     from scipy.sparse import csr_matrix
 
     inc = csr_matrix((np.ones(system.rows.size), (system.rows, system.cols)),
                      shape=(system.n_rows, system.n_cols))
-    inc_t = inc.T.tocsr()
+    return inc, inc.T.tocsr()
+
+
+def _local(system: LinearSystem, incidence, j: int, radius: int | None
+           ) -> tuple[LinearSystem, NDArray[np.int64]]:
+    """The rows within ``radius`` row-steps of column ``j`` (all rows reachable for None),
+    on the columns they use: ``(sub-system, its columns' indices in system)``."""
+    inc, inc_t = incidence
     cols = np.zeros(system.n_cols, dtype=bool)
     cols[j] = True
     rows = np.zeros(system.n_rows, dtype=bool)
@@ -444,18 +530,23 @@ def contract_columns(system: LinearSystem, lo: NDArray[np.float64], hi: NDArray[
     lo, hi = lo.copy(), hi.copy()
     used_cols = np.zeros(system.n_cols, dtype=bool)
     used_cols[system.cols[(system.a_lo != 0) | (system.a_hi != 0)]] = True
-    whole = None if radius is not None else (system, np.arange(system.n_cols))
-    whole_A = None if whole is None else system.mid_csr()
+    whole = None if radius is not None else (_Solver(system), np.arange(system.n_cols))
+    inc = None
     for j in targets:
         if not used_cols[j]:
             continue
-        sub, idx = whole if whole is not None else _local(system, int(j), radius)
-        A = whole_A if whole is not None else sub.mid_csr()
+        if whole is not None:
+            solver, idx = whole
+        else:
+            if inc is None:
+                inc = _incidence(system)
+            sub, idx = _local(system, inc, int(j), radius)
+            solver = _Solver(sub)
         k = int(np.searchsorted(idx, j))
         for sense in (1.0, -1.0):
-            c = np.zeros(sub.n_cols)
+            c = np.zeros(idx.size)
             c[k] = sense
-            bound = lp_bound(sub, c, lo[idx], hi[idx], A)
+            bound = solver.bound(c, lo[idx], hi[idx])
             if bound == np.inf:
                 return lo, hi, False
             if sense > 0:
