@@ -346,8 +346,10 @@ def test_propagate_lp_keeps_the_solution_and_narrows():
     m = Model()
     for v in (x, y, z):
         m.declare(v, (0.25, 10))
-    # solution x = 2, y = 1, z = 0.5 (x = 2 y, y = 2 z, x y z = 1)
-    m.add(x - 2 * y == 0, y - 2 * z == 0, (x * y * z).in_((1, 1)))
+    # solution x = 2, y = 1, z = 0.5 (x = 2 y, y = 2 z, x y z = 1): linear in log x, log y,
+    # log z (written as equalities, x is the slot of 2 y; ``x - 2 y == 0`` would be a linear
+    # row, which the log-linear system does not see)
+    m.add(x == 2 * y, y == 2 * z, (x * y * z).in_((1, 1)))
     hc = propagate(m)
     lp = propagate_lp(m, targets=["x", "y", "z"])
     assert lp.consistent and lp.rounds >= 1
@@ -356,3 +358,35 @@ def test_propagate_lp_keeps_the_solution_and_narrows():
         assert float(d.lo) <= val <= float(d.hi)
         assert float(d.hi - d.lo) <= float(hc[name].hi - hc[name].lo)
     assert float(lp["x"].hi - lp["x"].lo) < 1e-6
+
+
+@SETTINGS
+@given(small_lp("unbounded"))
+def test_linprog_fallback_is_sound_and_tight(p):
+    """The public ``linprog(method="highs")`` path (used where SciPy's bundled HiGHS bindings
+    are missing) gives the same guarantees."""
+    from boundest.ctc.linear import _Solver
+
+    c, A, b_lo, b_hi, lo, hi = p
+    solver = _Solver(LinearSystem.dense(A, b_lo, b_hi))
+    solver.highs = None
+    bound = solver.bound(c, lo, hi)
+    exact = exact_min(c, A, b_lo, b_hi, lo, hi)
+    if exact is None:
+        return
+    assert bound != np.inf
+    if exact == -math.inf:
+        assert bound == -np.inf
+    elif bound != -np.inf:
+        assert Fraction(bound) <= exact
+        if np.isfinite(lo).all() and np.isfinite(hi).all():
+            assert float(exact) - bound <= 1e-7 * (1 + abs(float(exact)))
+
+
+def test_missing_scipy_names_the_extra(monkeypatch):
+    import sys
+
+    t = compile_model([Var("x") + Var("y") == 1])
+    monkeypatch.setitem(sys.modules, "scipy.optimize", None)  # import fails as if absent
+    with pytest.raises(ImportError, match=r"pip install 'boundest\[lp\]'"):
+        CtcLinear(t)
