@@ -148,8 +148,9 @@ class _InProcess(Executor):
 
 def split_cost(box, kw: dict, eps: float, split: int, counts=(1, 16, 64, 256),
                repeat: int = 1) -> dict:
-    """Seconds (wall and CPU; median of ``repeat``) of the paving cut into ``counts`` parts paved one after
-    the other in this process: what cutting finer costs in work, without any transfer."""
+    """Seconds (wall and CPU; median of ``repeat``) of the paving cut into ``counts`` parts
+    paved one after the other in this process: what cutting finer costs in work, without any
+    transfer."""
     from boundest.paving import sivia
 
     out = {}
@@ -195,12 +196,13 @@ def project(rec: dict, workers: tuple[int, ...] = (1, 2, 10, 100)) -> dict:
             best = None
             for key in cost:
                 tasks = int(key)
-                if tasks < max(w, 2):
+                if tasks < 2:  # "1" is the paving without a cut
                     continue
+                busy = min(w, tasks)  # with fewer tasks than workers, some idle
                 work = base * cost[key]["cpu_s"]
                 t = (pv["head_s"] + pv["merge_s"] + prob["result_bytes"] / NETWORK_BYTES_PER_S
-                     + max(work / w + ratio * work / tasks
-                           + -(-tasks // w) * max(pv["overhead_per_task_s"], 0.0),
+                     + max(work / busy + ratio * work / tasks
+                           + -(-tasks // busy) * max(pv["overhead_per_task_s"], 0.0),
                            tasks * sched))
                 if best is None or t < best["time_s"]:
                     best = {"tasks": tasks, "time_s": t}
