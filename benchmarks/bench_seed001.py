@@ -3,7 +3,10 @@
 For each case it reports boundest's time to the fixed point (``solve(...).time_s``: the
 contraction only, building the tubes excluded and reported as ``build_s``), the median of
 ``--repeat`` runs after a warm-up run (the first run in the process also loads or compiles the
-Numba kernels: ``first_run_s``), the iterations and the widths that matter; then the same for
+Numba kernels: ``first_run_s``), the iterations and the widths that matter, and the same with
+the scenario's other ``CtcEval`` mode (``other_mode``: ``time_deriv`` flipped; the clock
+contracts its ``[t_i]`` with the derivative by default, the robot uses the plain inverse); then
+the same for
 Codac 1.5.7 (``benchmarks/seed001_codac.py``, run as a subprocess with
 ``.bench-venv-codac1/bin/python``, because importing codac switches the FPU to rounding upward),
 with speed-ups (Codac time / boundest time) and width ratios (Codac / boundest: > 1 means
@@ -73,6 +76,13 @@ def _timed(fn: Any, repeat: int) -> tuple[list, Any]:
 
 
 # -- boundest --------------------------------------------------------------------------------
+def _other_mode(solve: Any, width: Any, repeat: int) -> dict:
+    """The scenario with its other ``CtcEval`` mode (``time_deriv`` flipped): time and widths."""
+    times, res = _timed(solve, repeat)
+    return {"time_deriv": res.time_deriv, "time_s": statistics.median(times),
+            "iterations": res.iterations, **width(res)}
+
+
 def _bench_robot(ro: Any, dt: float, repeat: int) -> tuple[dict, Any]:
     t0 = time.perf_counter()
     first = ro.solve(dt=dt, progress=False)
@@ -93,7 +103,12 @@ def _bench_robot(ro: Any, dt: float, repeat: int) -> tuple[dict, Any]:
            "z_width_sum": float(np.sum(res.z.width())),
            "t_i": [[_r(float(a), 4), _r(float(b), 4)] for a, b in zip(res.t.lo, res.t.hi,
                                                                       strict=True)],
-           "contains_truth": bool(np.all(res.x.gates.contains(truth)))}
+           "contains_truth": bool(np.all(res.x.gates.contains(truth))),
+           "time_deriv": res.time_deriv,
+           "other_mode": _other_mode(
+               lambda: ro.solve(dt=dt, progress=False, time_deriv=not res.time_deriv),
+               lambda r: {"mean_diagonal_m": float(np.mean(r.position_diagonal())),
+                          "t_width_sum": float(np.sum(r.t.width()))}, min(repeat, 3))}
     return rec, res
 
 
@@ -115,7 +130,13 @@ def _bench_clock(dc: Any, dt: float, repeat: int) -> tuple[dict, Any]:
            "t_i": [[_r(float(a), 4), _r(float(b), 4)] for a, b in zip(res.t.lo, res.t.hi,
                                                                       strict=True)],
            "contains_truth": bool(res.h.gates.contains(truth.drift(res.h.t)).all()
-                                  and res.t.contains(t_exact).all())}
+                                  and res.t.contains(t_exact).all()),
+           "time_deriv": res.time_deriv,
+           "other_mode": _other_mode(
+               lambda: dc.solve(dt=dt, time_deriv=not res.time_deriv),
+               lambda r: {"t_width_sum": float(np.sum(r.t.width())),
+                          "t_i": [[_r(float(a), 4), _r(float(b), 4)]
+                                  for a, b in zip(r.t.lo, r.t.hi, strict=True)]}, repeat)}
     return rec, res
 
 
@@ -199,6 +220,11 @@ def _codac_clock_row(rec: dict, b_rec: dict, b_res: Any, dc: Any) -> dict:
                sampled_gates=len(idx), boundest_h_mean_width_sampled=b_mean,
                h_width_ratio=float(np.mean(hi - lo)) / b_mean,
                t_width_ratio=float(np.sum(t_hi - t_lo)) / b_rec["t_width_sum"])
+    # each [t_i] of boundest against Codac's (the issue's target: none wider)
+    bw, cw = b_res.t.hi - b_res.t.lo, t_hi - t_lo
+    row["t_i_wider_than_codac"] = int(np.sum(bw > cw))
+    row["t_i_max_excess_over_codac"] = float(np.max((bw - cw) / cw))
+    row["t_i_max_excess_over_codac_abs"] = float(np.max(bw - cw))
     return row
 
 
@@ -293,7 +319,9 @@ def main() -> None:
         b = row["boundest"]
         line = {"case": f"robot dt={row['dt']:g}", "boundest_s": _r(b["time_s"]),
                 "iterations": b["iterations"], "mean_d_m": _r(b["mean_diagonal_m"]),
-                "t_contracted": b["t_contracted"]}
+                "t_contracted": b["t_contracted"], "time_deriv": b["time_deriv"],
+                "other_mode_s": _r(b["other_mode"]["time_s"]),
+                "other_mode_mean_d_m": _r(b["other_mode"]["mean_diagonal_m"])}
         for c in row.get("codac", []):
             if "skipped" not in c:
                 line[f"codac_{c['variant']}_s"] = _r(c["time_s"])
@@ -304,12 +332,15 @@ def main() -> None:
         b = row["boundest"]
         line = {"case": f"clock dt={row['dt']:g}", "boundest_s": _r(b["time_s"]),
                 "iterations": b["iterations"], "t_width_sum": _r(b["t_width_sum"]),
-                "h_mean_width": _r(b["h_mean_width"])}
+                "h_mean_width": _r(b["h_mean_width"]), "time_deriv": b["time_deriv"],
+                "other_mode_s": _r(b["other_mode"]["time_s"]),
+                "other_mode_t_width_sum": _r(b["other_mode"]["t_width_sum"])}
         for c in row.get("codac", []):
             if "skipped" not in c:
                 line[f"codac_{c['variant']}_s"] = _r(c["time_s"])
                 line[f"codac_{c['variant']}_t_width_sum"] = _r(c["t_width_sum"])
                 line[f"codac_{c['variant']}_h_mean_width"] = _r(c["h_mean_width"])
+                line[f"t_i_wider_than_codac_{c['variant']}"] = c["t_i_wider_than_codac"]
                 line[f"speedup_{c['variant']}"] = _r(c["speedup"], 2)
         table.append(line)
     doc = {"benchmark": "seed001", "started": started, "machine": _machine(),

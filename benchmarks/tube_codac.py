@@ -11,7 +11,8 @@ then times, as the median of ``repeat`` runs on fresh copies:
 ``deriv``  ``CtcDeriv().contract(x, v)``: ``x`` entire but ``x(0) in [0, 0.1]``;
 ``eval``   ``CtcEval().contract(t, z, y, w)`` with ``y`` = [-100, 100], ``w = v``,
            ``t = [4, 5]``, ``z = [0, 0.5]``, ``preserve_slicing(True)`` (same slices as
-           boundest; Codac would otherwise add gates at the bounds of ``t``).
+           boundest; Codac would otherwise add gates at the bounds of ``t``);
+``unit``   Codac's own CtcEval unit cases (``unit_cases`` below): the contracted ``t``, ``z``.
 
 Output: one JSON document on stdout (floats as ``float.hex`` strings).
 
@@ -83,7 +84,44 @@ def main() -> None:
         row["eval_t"] = [float(tt.lb()).hex(), float(tt.ub()).hex()]
         row["eval_z"] = [float(zz.lb()).hex(), float(zz.ub()).hex()]
         out["cases"].append(row)
+    out["unit_cases"] = unit_cases(spec.get("unit_cases", []))
     json.dump(out, sys.stdout)
+
+
+def unit_cases(cases: list) -> list:
+    """Codac's own CtcEval unit cases (tests_ctc_eval.cpp): ``special`` on the tube of its
+    "special cases" (10 unit slices, x' in [-0.5, 1], slices 4, 5 in [-1.5, 1], [-1, 1.5],
+    then CtcDeriv), ``case2`` its "CtcEval, 2" (two evaluations on a tube with x(2) in [0, 1]).
+    Slicing preserved, temporal propagation on (Codac's defaults apart from the slicing)."""
+    from codac import CtcDeriv, CtcEval, Interval, Tube
+
+    out = []
+    for c in cases:
+        if c["kind"] == "special":
+            xdot = Tube(Interval(0.0, 10.0), 1.0)
+            xdot.set(Interval(-0.5, 1.0))
+            x = Tube(xdot)
+            x.set(Interval())
+            x.set(Interval(-1.5, 1.0), 4)
+            x.set(Interval(-1.0, 1.5), 5)
+            CtcDeriv().contract(x, xdot)
+            evals = [(c["t"], c["z"])]
+        else:
+            x = Tube(Interval(-1.0, 7.0), 2.0)
+            xdot = Tube(x)
+            for k, val in enumerate([(-1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0), (1.0, 1.0)]):
+                xdot.set(Interval(*val), k)
+            x.set(Interval(0.0, 1.0), 2.0)
+            xdot.sample(2.0)
+            evals = [((0.0, 6.0), (-1.0, 1.0)), (c["t"], c["z"])]
+        for tt, zz in evals:
+            ctc = CtcEval()
+            ctc.preserve_slicing(True)
+            T, Z = Interval(*tt), Interval(*zz)
+            ctc.contract(T, Z, x, xdot)
+        out.append({"name": c["name"], "t": [float(T.lb()).hex(), float(T.ub()).hex()],
+                    "z": [float(Z.lb()).hex(), float(Z.ub()).hex()]})
+    return out
 
 
 if __name__ == "__main__":

@@ -19,6 +19,7 @@ from hypothesis import strategies as st
 
 from boundest import Interval, Var
 from boundest.tube import ContractorNetwork, CtcDeriv, CtcEval, CtcSlices, Tube
+from boundest.tube.eval import invert_kernel
 
 from .test_tube import grids, inside, sample_times, seeds, trajectories, tube_around, tube_keeps
 
@@ -103,8 +104,9 @@ def test_deriv_backward_and_empty():
 
 # -- CtcEval --
 @settings(max_examples=60)
-@given(trajectories(), grids(), seeds, st.floats(0, 1), st.floats(0, 0.3), st.floats(0, 1))
-def test_eval_keeps_truth(tr, t, seed, where, trad, zrad):
+@given(trajectories(), grids(), seeds, st.floats(0, 1), st.floats(0, 0.3), st.floats(0, 1),
+       st.booleans())
+def test_eval_keeps_truth(tr, t, seed, where, trad, zrad, time_deriv):
     rng = np.random.default_rng(seed)
     y = tube_around(tr, t, rng, p_entire=0.2)
     w = tube_around(tr, t, rng, p_entire=0.02, deriv=True)
@@ -117,9 +119,110 @@ def test_eval_keeps_truth(tr, t, seed, where, trad, zrad):
     z = Interval(float(zt) - zrad * rng.random() - 1e-9, float(zt) + zrad * rng.random() + 1e-9)
     if rng.random() < 0.3:
         tm = Interval(ts, ts)
-    tm, z = CtcEval().contract(tm, z, y, w)
+    tm, z = CtcEval(time_deriv).contract(tm, z, y, w)
     assert inside(tm, mpmath.mpf(ts)) and inside(z, zt)
     assert tube_keeps(y, tr, sample_times(t, rng))
+
+
+@settings(max_examples=80)
+@given(trajectories(), grids(), seeds, st.floats(0, 1), st.floats(0, 1),
+       st.sampled_from([0.0, 1e-9, 1e-3, 0.05, 0.3]), st.booleans(),
+       st.sampled_from([0.0, 0.1, 1.0]))
+def test_invert_keeps_every_feasible_time(tr, t, seed, where, span, zrad, consistent, p_inf):
+    # every time s in [t] at which the true trajectory lies in [z] (decided exactly with
+    # mpmath) survives the inversion with the derivative, and so does its value; the tube may
+    # be raw (gates and slices widened at random, some unbounded) or CtcDeriv-consistent
+    rng = np.random.default_rng(seed)
+    y = tube_around(tr, t, rng, p_entire=0.1 * p_inf)
+    w = tube_around(tr, t, rng, p_entire=0.02 * p_inf, deriv=True)
+    if consistent:
+        CtcDeriv().contract(y, w)
+    a = float(t[0] + where * (t[-1] - t[0]))
+    b = min(float(t[-1]), a + span * (t[-1] - t[0]))
+    s0 = float(rng.uniform(a, b)) if b > a else a
+    v0 = tr.value(s0)
+    z = (float(v0) - zrad - 1e-12, float(v0) + zrad + 1e-12)
+    lo, hi, zl, zh = invert_kernel(y.t, y.slices.lo, y.slices.hi, y.gates.lo, y.gates.hi,
+                                   w.slices.lo, w.slices.hi, a, b, *z)
+    times = np.concatenate([[a, b, s0], rng.uniform(a, b, 80), t[(t >= a) & (t <= b)]])
+    for s in times:
+        v = tr.value(float(s))
+        if mpmath.mpf(z[0]) <= v <= mpmath.mpf(z[1]):
+            assert lo <= s <= hi, (s, lo, hi)
+            assert mpmath.mpf(zl) <= v <= mpmath.mpf(zh)
+
+
+def test_invert_by_hand_and_degenerate():
+    # y' = 1 exactly, y(0) = 0: y(s) = s; y in [3, 3.5] only for s in [3, 3.5] (the plain
+    # inverse gives the whole slices that meet [3, 3.5]: [2, 3] (at its end) and [3, 4])
+    t = np.arange(6.0)
+    y = Tube(t, Interval.entire(5))
+    y.gates[0] = Interval(0.0)
+    w = Tube.constant(0, 5, 5, Interval(1.0))
+    CtcDeriv().contract(y, w)
+    assert invert_kernel(y.t, y.slices.lo, y.slices.hi, y.gates.lo, y.gates.hi, w.slices.lo,
+                         w.slices.hi, 0.0, 5.0, 3.0, 3.5) == (3.0, 3.5, 3.0, 3.5)
+    tm, _ = CtcEval(time_deriv=False).contract(Interval(0, 5), Interval(3, 3.5), y.copy(), w)
+    assert (float(tm.lo), float(tm.hi)) == (2.0, 4.0)
+    # no time at all, and an unbounded derivative (the cones say nothing: the plain inverse)
+    lo, hi, _, _ = invert_kernel(y.t, y.slices.lo, y.slices.hi, y.gates.lo, y.gates.hi,
+                                 w.slices.lo, w.slices.hi, 0.0, 2.0, 3.0, 3.5)
+    assert lo > hi
+    we = Tube.constant(0, 5, 5)
+    assert invert_kernel(y.t, y.slices.lo, y.slices.hi, y.gates.lo, y.gates.hi, we.slices.lo,
+                         we.slices.hi, 0.0, 5.0, 3.0, 3.5)[:2] == (2.0, 4.0)
+    # a degenerate [t] inside a slice, and at a gate
+    assert invert_kernel(y.t, y.slices.lo, y.slices.hi, y.gates.lo, y.gates.hi, w.slices.lo,
+                         w.slices.hi, 3.25, 3.25, 3.0, 3.5)[:2] == (3.25, 3.25)
+    assert invert_kernel(y.t, y.slices.lo, y.slices.hi, y.gates.lo, y.gates.hi, w.slices.lo,
+                         w.slices.hi, 3.0, 3.0, 3.0, 3.5)[:2] == (3.0, 3.0)
+
+
+def _codac_special_tube() -> tuple[Tube, Tube]:
+    """Codac's "CtcEval, special cases" (tests_ctc_eval.cpp): 10 unit slices on [0, 10],
+    x' in [-0.5, 1], x entire but slices 4 and 5 in [-1.5, 1] and [-1, 1.5], then CtcDeriv."""
+    t = np.arange(11.0)
+    xd = Tube.constant(0, 10, 10, Interval(-0.5, 1))
+    s = Interval.entire(10)
+    s[4], s[5] = Interval(-1.5, 1), Interval(-1, 1.5)
+    x = Tube(t, s)
+    CtcDeriv().contract(x, xd)
+    return x, xd
+
+
+# Codac's expected [t] and [z] (by hand: the cones of x' in [-0.5, 1] from the gates)
+CODAC_CASES = [((0.5, 3.5), (-4, -4), (0.5, 1.5), (-4, -4)),          # test C
+               ((6.5, 8.5), (-4.5, -1.75), (7.5, 8.5), (-2.25, -1.75)),  # test E
+               ((6.5, 7.5), (3, 4), (7.5, 7.5), (3, 3)),               # test G
+               ((8.5, 9.5), (-0.5, 2.5), (8.5, 9.5), (-0.5, 2.5)),     # test F
+               ((0.5, 2.5), (-2, -2), (0.5, 2.5), (-2, -2))]           # test B
+
+
+@pytest.mark.parametrize(("tm", "zm", "t_exp", "z_exp"), CODAC_CASES)
+def test_eval_codac_unit_cases(tm, zm, t_exp, z_exp):
+    x, xd = _codac_special_tube()
+    assert (float(x.gates.lo[0]), float(x.gates.hi[0])) == (-5.5, 3.0)  # Codac's x_raw(0)
+    T, Z = CtcEval().contract(Interval(*tm), Interval(*zm), x.copy(), xd)
+    assert (float(T.lo), float(T.hi)) == t_exp and (float(Z.lo), float(Z.hi)) == z_exp
+    # the plain inverse is never tighter
+    T0, _ = CtcEval(time_deriv=False).contract(Interval(*tm), Interval(*zm), x.copy(), xd)
+    assert float(T0.lo) <= t_exp[0] and t_exp[1] <= float(T0.hi)
+
+
+def test_eval_codac_unit_case_2():
+    # Codac's "CtcEval, 2": slices [-1, 1, 2, 3, 5, 7], x' = -1, [-1, 1], [-1, 1], -1, 1 and
+    # x(2) in [0, 1]; after y(t) in [-1, 1] for t in [0, 6], the value 1.6 is reached only for
+    # t in [2.6, 3.4] (x(3) in [-1, 2], then x' = -1 down to x(3.4) <= 1.6)
+    t = np.array([-1.0, 1, 2, 3, 5, 7])
+    x = Tube(t, Interval.entire(5))
+    x.gates[2] = Interval(0, 1)
+    v = Tube.piecewise_constant(t, Interval([-1, -1, -1, -1, 1], [-1, 1, 1, -1, 1]))
+    CtcEval().contract(Interval(0, 6), Interval(-1, 1), x, v)
+    T, Z = CtcEval().contract(Interval(1.75, 5.5), Interval(1.6), x, v)
+    assert abs(float(T.lo) - 2.6) < 1e-12 and abs(float(T.hi) - 3.4) < 1e-12
+    z = Fraction(1.6)  # the float: the exact bounds are 2 + (z - 1) and 3 + (2 - z)
+    assert Fraction(float(T.lo)) <= 1 + z and 5 - z <= Fraction(float(T.hi))
+    assert float(Z.lo) == 1.6 == float(Z.hi)
 
 
 @settings(max_examples=60)

@@ -17,7 +17,7 @@ def run(args: argparse.Namespace) -> int:
 
     meas = dc.load(args.data)
     print(f"drifting clock (Rohou et al. 2018): {len(meas)} measurements, data {meas.source}")
-    res = dc.solve(meas, dt=args.dt, rel_eps=args.rel_eps)
+    res = dc.solve(meas, dt=args.dt, rel_eps=args.rel_eps, time_deriv=not args.plain_eval)
     if res.empty:
         print(f"proven INCONSISTENT after {res.iterations} iterations: no drift and boat path "
               "of the model meet every measurement")
@@ -53,6 +53,9 @@ def register(runs: argparse._SubParsersAction) -> None:
     p.add_argument("--rel-eps", type=float, default=1e-4,
                    help="stop when an iteration shrinks the domains by less than this fraction "
                         "(default 1e-4)")
+    p.add_argument("--plain-eval", action="store_true",
+                   help="contract the [t_i] with the plain tube inverse (whole slices) instead "
+                        "of the derivative inside the slices (the default)")
     p.add_argument("--out", default="out", help="folder for figures (default: out)")
     p.add_argument("--json", help="write [h], [y] and the [t_i] as JSON to this file "
                    "(strict JSON: docs/json.md)")

@@ -238,6 +238,7 @@ class ClockResult:
     time_s: float
     build_s: float
     contraction: list[float]
+    time_deriv: bool = True
 
     @property
     def consistent(self) -> bool:
@@ -265,6 +266,7 @@ class ClockResult:
             "time_s": self.time_s,
             "build_s": self.build_s,
             "n_slices": self.h.n_slices,
+            "ctc_eval": "time-deriv" if self.time_deriv else "plain",
             "contraction": fl(self.contraction),
             "t": fl(self.h.t),
             "h_lo": fl(self.h.gates.lo), "h_hi": fl(self.h.gates.hi),
@@ -285,8 +287,8 @@ def _item(a: Interval, i: int) -> Interval:
 
 
 def solve(meas: ClockMeasurements | None = None, dt: float = 0.01, tf: float | None = None,
-          rel_eps: float = 1e-4, max_iter: int = 100, progress: bool | None = None
-          ) -> ClockResult:
+          rel_eps: float = 1e-4, max_iter: int = 100, progress: bool | None = None,
+          time_deriv: bool = True) -> ClockResult:
     """Contract CN (20) over ``[0, tf]`` (default :func:`t_final`) sliced every ``dt``.
 
     Each iteration applies ``x' = v``, the distance functions, ``y' = w``, ``h' = phi``, then for
@@ -294,6 +296,10 @@ def solve(meas: ClockMeasurements | None = None, dt: float = 0.01, tf: float | N
     each). It stops as :meth:`ContractorNetwork.contract` does (relative decrease of the total
     width below ``rel_eps``), or when a domain becomes empty. ``progress``: the network's
     iteration counter with the last contraction (``None``: only for runs longer than 2 s).
+    ``time_deriv``: :class:`CtcEval` contracts the ``[t_i]`` with the derivative inside the
+    slices (default: the ``[t_i]`` then lie inside slices, no wider than Codac's at equal
+    ``dt``; ``benchmarks/bench_seed001.py``); ``False``: the plain tube inverse, whole slices
+    (the ``[t_i]`` end on gate times; about as fast).
     """
     meas = load() if meas is None else meas
     if not (np.isfinite(dt) and dt > 0):
@@ -317,7 +323,7 @@ def solve(meas: ClockMeasurements | None = None, dt: float = 0.01, tf: float | N
                           wv == (x1 * v1 + x2 * v2) / yv], ["x1", "x2", "v1", "v2", "y", "w"])
     t_i = Interval._new(np.zeros(len(meas)), np.full(len(meas), tf))
     z = meas.z.copy()
-    deriv, ev = CtcDeriv(), CtcEval()
+    deriv, ev = CtcDeriv(), CtcEval(time_deriv)
     deriv.contract(h, phi)
     t_initial = Interval._new(*np.array([[float(r.lo), float(r.hi)] for r in
                                          (h.inverse(meas.tau[i], hull=True)
@@ -335,4 +341,4 @@ def solve(meas: ClockMeasurements | None = None, dt: float = 0.01, tf: float | N
     build_s = time.perf_counter() - start
     rep = cn.contract(rel_eps=rel_eps, max_iter=max_iter, progress=progress)
     return ClockResult(meas, h, y, t_i, t_initial, z, rep.iterations, rep.converged, rep.empty,
-                       rep.time_s, build_s, list(rep.contraction))
+                       rep.time_s, build_s, list(rep.contraction), time_deriv)

@@ -30,11 +30,21 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..interval import Interval, as_interval
-from ..interval.rounding import INF, add_dn, add_up, mul_dn, mul_up, sub_dn, sub_up
+from ..interval.rounding import (
+    INF,
+    add_dn,
+    add_up,
+    div_dn,
+    div_up,
+    mul_dn,
+    mul_up,
+    sub_dn,
+    sub_up,
+)
 from .deriv import _lin_dn, _lin_up, slice_hi
 from .tube import Tube
 
-__all__ = ["CtcEval", "eval_kernel"]
+__all__ = ["CtcEval", "eval_kernel", "invert_kernel"]
 
 _njit = nb.njit(cache=True, error_model="numpy")
 
@@ -55,6 +65,111 @@ def _dur(a: float, b: float) -> tuple[float, float]:
     """Enclosure of ``b - a`` clamped at 0 below."""
     lo = sub_dn(b, a)
     return (lo if lo > 0.0 else 0.0), sub_up(b, a)
+
+
+@_njit
+def _half(b: float, d: float) -> tuple[float, float]:
+    """An enclosure of ``{u : b u <= d}`` (``d`` an upper bound; ``(INF, -INF)`` when empty).
+    A non-finite ``b`` or a NaN ``d`` gives the whole line (a dropped constraint)."""
+    if not (-INF < b < INF) or d != d:
+        return -INF, INF
+    if b > 0.0:
+        return -INF, div_up(d, b)
+    if b < 0.0:
+        return div_dn(d, b), INF
+    return (-INF, INF) if d >= 0.0 else (INF, -INF)
+
+
+@_njit
+def _slice_times(t0: float, t1: float, g0lo: float, g0hi: float, g1lo: float, g1hi: float,
+                 wlo: float, whi: float, x: float, y: float) -> tuple[float, float]:
+    """Enclosure of the times ``s ∈ [t0, t1]`` at which a trajectory of the slice polygon (entry
+    gate ``g0``, exit gate ``g1``, ``y' ∈ [wlo, whi]``) may take a value in ``[x, y]``.
+
+    With ``τ = s - t0`` and ``σ = t1 - s`` the values at ``s`` are bounded by the cones
+    ``[g0lo + τ wlo, g0hi + τ whi]`` and ``[g1lo - σ whi, g1hi - σ wlo]``; the value set meets
+    ``[x, y]`` (already inside the slice envelope) iff each cone bound is on the right side of
+    ``[x, y]`` (the other pairs of bounds do not depend on ``s``: they hold for consistent
+    gates). Each of the four conditions is a half-line in ``τ`` or ``σ`` (Fourier-Motzkin on
+    the polygon), so the result is the exact projection, rounded outward."""
+    a_lo, a_hi = _half(wlo, sub_up(y, g0lo))            # g0lo + τ wlo <= y
+    b_lo, b_hi = _half(-whi, sub_up(g0hi, x))           # g0hi + τ whi >= x
+    c_lo, c_hi = _half(-whi, sub_up(y, g1lo))           # g1lo - σ whi <= y
+    d_lo, d_hi = _half(wlo, sub_up(g1hi, x))            # g1hi - σ wlo >= x
+    tau_lo, tau_hi = max(a_lo, b_lo), min(a_hi, b_hi)
+    sig_lo, sig_hi = max(c_lo, d_lo), min(c_hi, d_hi)
+    if not (tau_lo <= tau_hi and sig_lo <= sig_hi):
+        return INF, -INF
+    lo = max(t0, add_dn(t0, tau_lo), sub_dn(t1, sig_hi))
+    hi = min(t1, add_up(t0, tau_hi), sub_up(t1, sig_lo))
+    return (lo, hi) if lo <= hi else (INF, -INF)
+
+
+@_njit
+def invert_kernel(t: NDArray, slo: NDArray, shi: NDArray, glo: NDArray, ghi: NDArray,
+                  wlo: NDArray, whi: NDArray, tlo: float, thi: float, zlo: float, zhi: float
+                  ) -> tuple[float, float, float, float]:
+    """``[t] ∩ [y]^{-1}([z])`` with the derivative: the hull of the times in ``[tlo, thi]``
+    (inside the domain, ``tlo <= thi``) at which a trajectory of the scalar tube with
+    ``y' ∈ [w]`` may lie in ``[z]`` (on each slice, the polygon of the two cones from its gates
+    inside its envelope, projected exactly; Rohou et al. 2018 use the same polygon), and the
+    hull of the values in ``[z]`` such trajectories take over the contracted times (the polygon
+    between virtual gates at the new bounds of ``[t]``). Returns ``(t_lo, t_hi, z_lo, z_hi)``,
+    ``t_lo > t_hi`` when no trajectory meets ``[z]`` in ``[t]``."""
+    n = slo.size
+    i0 = min(max(np.searchsorted(t, tlo, side="right") - 1, 0), n - 1)
+    i1 = min(max(np.searchsorted(t, thi, side="left"), i0 + 1), n)
+    rlo, rhi = INF, -INF
+    for i in range(i0, i1):
+        p, q = max(t[i], tlo), min(t[i + 1], thi)
+        if p > q:
+            continue
+        x, y = max(slo[i], zlo), min(shi[i], zhi)
+        if not x <= y:
+            continue
+        a, b = _slice_times(t[i], t[i + 1], glo[i], ghi[i], glo[i + 1], ghi[i + 1], wlo[i],
+                            whi[i], x, y)
+        a, b = max(a, p), min(b, q)
+        if a <= b:
+            rlo, rhi = min(rlo, a), max(rhi, b)
+    if not rlo <= rhi:
+        return INF, -INF, INF, -INF
+    # the values over the contracted times: each slice part [a, b] is bounded by the polygon
+    # between virtual gates at a and b (the cone bounds there, inside the envelope)
+    ylo, yhi = INF, -INF
+    j0 = min(max(np.searchsorted(t, rlo, side="right") - 1, 0), n - 1)
+    j1 = min(max(np.searchsorted(t, rhi, side="left"), j0 + 1), n)
+    for i in range(j0, j1):
+        a, b = max(t[i], rlo), min(t[i + 1], rhi)
+        if a > b:
+            continue
+        va = _cone(t[i], t[i + 1], a, glo[i], ghi[i], glo[i + 1], ghi[i + 1], wlo[i], whi[i])
+        vb = _cone(t[i], t[i + 1], b, glo[i], ghi[i], glo[i + 1], ghi[i + 1], wlo[i], whi[i])
+        h_dn, h_up = _dur(a, b)
+        hi = min(shi[i], slice_hi(va[1], vb[1], wlo[i], whi[i], h_dn, h_up))
+        lo = max(slo[i], -slice_hi(-va[0], -vb[0], -whi[i], -wlo[i], h_dn, h_up))
+        ylo, yhi = min(ylo, lo), max(yhi, hi)
+    return rlo, rhi, max(ylo, zlo), min(yhi, zhi)
+
+
+@_njit
+def _cone(t0: float, t1: float, s: float, g0lo: float, g0hi: float, g1lo: float, g1hi: float,
+          wlo: float, whi: float) -> tuple[float, float]:
+    """Bounds at ``s ∈ [t0, t1]`` of the trajectories through the gates with ``y' ∈ [w]``."""
+    if s == t0:
+        return g0lo, g0hi
+    if s == t1:
+        return g1lo, g1hi
+    tau_dn, tau_up = _dur(t0, s)
+    sig_dn, sig_up = _dur(s, t1)
+    lo, hi = -INF, INF
+    for c in (_lin_dn(g0lo, tau_dn, tau_up, wlo), _lin_dn(g1lo, sig_dn, sig_up, -whi)):
+        if c > lo:  # a NaN bound (inf - inf) is dropped
+            lo = c
+    for c in (_lin_up(g0hi, tau_dn, tau_up, whi), _lin_up(g1hi, sig_dn, sig_up, -wlo)):
+        if c < hi:
+            hi = c
+    return lo, hi
 
 
 @_njit
@@ -105,12 +220,17 @@ def eval_kernel(t: NDArray, slo: NDArray, shi: NDArray, glo: NDArray, ghi: NDArr
                     _, d1 = _dur(t[i], q)
                     lo = min(lo, add_dn(zl, _mul_lo(d0, d1, -whi[i])))
                     hi = max(hi, add_up(zh, _mul_hi(d0, d1, -wlo[i])))
-                    slo_b = min(slo_b, add_dn(zl, min(0.0, _mul_lo(h_dn, h_up, -whi[i]))))
-                    shi_b = max(shi_b, add_up(zh, max(0.0, _mul_hi(h_dn, h_up, -wlo[i]))))
+                    # B on the slice from t1 <= q: durations t1 - s in [0, q - t_i]
+                    slo_b = min(slo_b, add_dn(zl, _mul_lo(0.0, d1, -whi[i])))
+                    shi_b = max(shi_b, add_up(zh, _mul_hi(0.0, d1, -wlo[i])))
             SBlo[k - ra], SBhi[k - ra] = slo_b, shi_b
         if k0 <= k < k1:
             lo, hi = min(lo, max(zlo, glo[k])), max(hi, min(zhi, ghi[k]))
         lo, hi = max(lo, glo[k]), min(hi, ghi[k])
+        if k < rb:  # and inside the backward cone of the next gate (y' = w on every trajectory)
+            h_dn, h_up = _dur(t[k], t[k + 1])
+            lo = max(lo, _lin_dn(glo[k + 1], h_dn, h_up, -whi[k]))
+            hi = min(hi, _lin_up(ghi[k + 1], h_dn, h_up, -wlo[k]))
         if not lo <= hi:
             lo, hi = INF, -INF
         Blo[k - ra], Bhi[k - ra] = lo, hi
@@ -135,16 +255,21 @@ def eval_kernel(t: NDArray, slo: NDArray, shi: NDArray, glo: NDArray, ghi: NDArr
                     _, d1 = _dur(p, t[i + 1])
                     lo = min(lo, add_dn(zl, _mul_lo(d0, d1, wlo[i])))
                     hi = max(hi, add_up(zh, _mul_hi(d0, d1, whi[i])))
-                    slo_f = min(slo_f, add_dn(zl, min(0.0, _mul_lo(h_dn, h_up, wlo[i]))))
-                    shi_f = max(shi_f, add_up(zh, max(0.0, _mul_hi(h_dn, h_up, whi[i]))))
+                    # F on the slice from t1 >= p: durations s - t1 in [0, t_{i+1} - p]
+                    slo_f = min(slo_f, add_dn(zl, _mul_lo(0.0, d1, wlo[i])))
+                    shi_f = max(shi_f, add_up(zh, _mul_hi(0.0, d1, whi[i])))
         if k0 <= k < k1:
             lo, hi = min(lo, max(zlo, glo[k])), max(hi, min(zhi, ghi[k]))
         covers = lo <= glo[k] and hi >= ghi[k]
         lo, hi = max(lo, glo[k]), min(hi, ghi[k])
         if not lo <= hi:
             lo, hi = INF, -INF
-        if k <= rb:  # gate inside the region: F ∪ B
+        if k <= rb:  # gate inside the region: F ∪ B, inside the cone of the previous gate
             gl, gh = min(lo, Blo[k - ra]), max(hi, Bhi[k - ra])
+            if k > ra:
+                h_dn, h_up = _dur(t[k - 1], t[k])
+                gl = max(gl, _lin_dn(glo[k - 1], h_dn, h_up, wlo[k - 1]))
+                gh = min(gh, _lin_up(ghi[k - 1], h_dn, h_up, whi[k - 1]))
         else:
             gl, gh = lo, hi
         if not gl <= gh:
@@ -205,6 +330,17 @@ class CtcEval:
     constraint holds componentwise at the same time ``t``. When the measurement cannot be met,
     ``t``, ``z`` and ``y`` all become empty.
 
+    Parameters
+    ----------
+    time_deriv : bool
+        ``True`` (default): ``[t]`` is contracted with the derivative, to the times at which a
+        trajectory of the slice polygons (the cones of ``y' = w`` from the gates, inside the
+        envelope) meets ``[z]``, so ``[t]`` shrinks inside a slice; ``[z]`` to the values of
+        those trajectories over the new ``[t]`` (virtual gates at its bounds); and both again
+        after the tube is contracted (as Codac's ``CtcEval`` does with ``y.invert(z, w, t)``).
+        ``False``: the plain tube inverse ``[y]^{-1}([z])`` (whole slices) and ``[y]([t])``,
+        once; cheaper, wider.
+
     Only the slices of ``w`` are read: the derivative may jump at every gate (a tube with
     ``continuous=False``). ``y`` has a derivative, so a tube ``y`` with jumps is made
     continuous first (:meth:`Tube.make_continuous`).
@@ -218,6 +354,12 @@ class CtcEval:
     >>> bool(y(9).hi <= 7.0)
     True
     """
+
+    def __init__(self, time_deriv: bool = True) -> None:
+        self.time_deriv = bool(time_deriv)
+
+    def __repr__(self) -> str:
+        return f"CtcEval(time_deriv={self.time_deriv})"
 
     def contract(self, t: Interval, z: Interval, y: Tube, w: Tube) -> tuple[Interval, Interval]:
         t, z = as_interval(t), as_interval(z)
@@ -234,27 +376,36 @@ class CtcEval:
         tl, th = (max(float(t.lo), t0), min(float(t.hi), tf)) if ok else (1.0, 0.0)
         ok = ok and tl <= th
         comps = [y[j] for j in range(y.dim)] if y.is_vector else [y]
-        zs = [z[j] for j in range(y.dim)] if y.is_vector else [z]
-        if ok:  # [t] ∩ [y]^{-1}([z]) for every component, then [z] ∩ [y]([t])
-            for yj, zj in zip(comps, zs, strict=True):
+        wcomps = [w[j] for j in range(w.dim)] if w.is_vector else [w]
+        zlo = np.array(z.lo, dtype=np.float64).reshape(-1)
+        zhi = np.array(z.hi, dtype=np.float64).reshape(-1)
+        if ok and self.time_deriv:
+            ok, tl, th = _invert_all(comps, wcomps, tl, th, zlo, zhi)
+        elif ok:  # [t] ∩ [y]^{-1}([z]) for every component, then [z] ∩ [y]([t])
+            for yj, zj in zip(comps, [Interval(a, b) for a, b in zip(zlo, zhi, strict=True)],
+                              strict=True):
                 inv = yj.inverse(zj, hull=True, within=Interval(tl, th))
                 if inv.is_empty():
                     ok = False
                     break
                 tl, th = float(inv.lo), float(inv.hi)
-        znew = z & y(Interval(tl, th)) if ok else z
-        ok = ok and not np.any(znew.is_empty())
+            if ok:
+                znew = z & y(Interval(tl, th))
+                zlo = np.array(znew.lo, dtype=np.float64).reshape(-1)
+                zhi = np.array(znew.hi, dtype=np.float64).reshape(-1)
+                ok = not np.any(np.isnan(zlo))
         if ok:
-            zs = [znew[j] for j in range(y.dim)] if y.is_vector else [znew]
-            for yj, wj, zj in zip(comps, [w[j] for j in range(w.dim)] if w.is_vector else [w],
-                                  zs, strict=True):
+            for j, (yj, wj) in enumerate(zip(comps, wcomps, strict=True)):
                 ok = eval_kernel(yj.t, yj.slices.lo, yj.slices.hi, yj.gates.lo, yj.gates.hi,
-                                 wj.slices.lo, wj.slices.hi, tl, th, float(zj.lo), float(zj.hi))
+                                 wj.slices.lo, wj.slices.hi, tl, th, float(zlo[j]),
+                                 float(zhi[j]))
                 if not ok:
                     break
+        if ok and self.time_deriv:  # again on the contracted tube
+            ok, tl, th = _invert_all(comps, wcomps, tl, th, zlo, zhi)
         if ok:
             t.lo[...], t.hi[...] = tl, th
-            z.lo[...], z.hi[...] = znew.lo, znew.hi
+            z.lo[...], z.hi[...] = zlo.reshape(z.shape), zhi.reshape(z.shape)
         else:
             t.lo[...] = t.hi[...] = np.nan
             z.lo[...] = z.hi[...] = np.nan
@@ -262,3 +413,21 @@ class CtcEval:
         return t, z
 
     __call__ = contract
+
+
+def _invert_all(comps: list[Tube], wcomps: list[Tube], tl: float, th: float, zlo: NDArray,
+                zhi: NDArray) -> tuple[bool, float, float]:
+    """``[t]`` by :func:`invert_kernel` over every component (one time for all), then each
+    ``[z_j]`` over the final ``[t]``, in place. Returns ``(ok, t_lo, t_hi)``."""
+    for _ in range(2):  # the second pass: every [z_j] over the [t] of all components
+        for j, (yj, wj) in enumerate(zip(comps, wcomps, strict=True)):
+            a, b, c, d = invert_kernel(yj.t, yj.slices.lo, yj.slices.hi, yj.gates.lo,
+                                       yj.gates.hi, wj.slices.lo, wj.slices.hi, tl, th,
+                                       float(zlo[j]), float(zhi[j]))
+            if not (a <= b and c <= d):
+                return False, tl, th
+            tl, th = max(tl, a), min(th, b)
+            zlo[j], zhi[j] = c, d
+        if len(comps) == 1:
+            break
+    return True, tl, th
