@@ -17,9 +17,9 @@ from .commands import SCENARIOS, pyplot, save_figure, write_json
 
 #: Measured empty-cache compile time of each command on the project's 2-core machine
 #: (``benchmarks/bench_startup.py``; the pool: 69 s, its observer one compiled kernel; the
-#: satellite: with its shaving kernel, 30 s wall for the whole cold run, measured by hand),
+#: satellite: with its shaving kernel, 23 s wall for the whole cold run, measured by hand),
 #: printed when a run starts compiling.
-COMPILE_ESTIMATE_S = {"satellite": 28, "jaulin2001": 11, "range-only": 23,
+COMPILE_ESTIMATE_S = {"satellite": 21, "jaulin2001": 11, "range-only": 23,
                       "drifting-clock": 12, "auv": 20, "pool": 70, "solve": 13, "demo": 5}
 
 

@@ -67,11 +67,13 @@ def _undo(lo, hi, trail, tval, tpos):
 @nb.njit(cache=True, inline="always", error_model="numpy")
 def _update(s, nl, nh, lo, hi, rel_eps, trail, tval, tpos):
     """Intersect slot ``s`` with ``[nl, nh]``: -1 empty, 1 significant shrink, 0 otherwise.
-    With a trail (``trail is not None``) the old domain is recorded before it changes."""
+    With a trail (``trail.size > 0``) the old domain is recorded before it changes. (An empty
+    trail, not None, when there is none: one compiled version of the revisions serves both
+    kernels, the probes and the plain propagation.)"""
     ol, oh = lo[s], hi[s]
     nl = max(nl, ol) if nl == nl else nl  # NaN (empty) must survive the max
     nh = min(nh, oh) if nh == nh else nh
-    if trail is not None and not (nl == ol and nh == oh):
+    if trail.size > 0 and not (nl == ol and nh == oh):
         _record(s, lo, hi, trail, tval, tpos)
     if nl != nl or nh != nh or nl > nh:
         lo[s] = np.nan
@@ -207,7 +209,7 @@ def propagate_kernel(op, out, a, b, param, lo, hi, ptr, adj, dirty, state, rel_e
         w = wpos if direction > 0 else nw - 1 - wpos
         wpos += 1
         if not _settle(w, direction, op, out, a, b, param, lo, hi, ptr, adj, dirty, pending,
-                       span, window, rel_eps, buf, changed, cnt, max_evals, None, None, tpos,
+                       span, window, rel_eps, buf, changed, cnt, max_evals, tpos[:0], buf[:0], tpos,
                        piecewise, pown, explog, trig):
             status = EMPTY
             break
@@ -306,7 +308,7 @@ def shave_kernel(op, out, a, b, param, lo, hi, ptr, adj, cand, rel_eps, probe_ep
     for k in range(stats.size):
         stats[k] = 0
     if not _drain(op, out, a, b, param, lo, hi, ptr, adj, dirty, pending, span, window, rel_eps,
-                  buf, changed, cnt, big, None, None, tpos, piecewise, pown, explog, trig):
+                  buf, changed, cnt, big, tpos[:0], buf[:0], tpos, piecewise, pown, explog, trig):
         stats[4] = cnt[1]
         return EMPTY
     total = cnt[1]
@@ -356,7 +358,7 @@ def shave_kernel(op, out, a, b, param, lo, hi, ptr, adj, cand, rel_eps, probe_ep
                     _touch(s, ptr, adj, dirty, pending, span, window, cnt)
                     cnt[1] = 0
                     ok = _drain(op, out, a, b, param, lo, hi, ptr, adj, dirty, pending, span,
-                                window, rel_eps, buf, changed, cnt, big, None, None, tpos,
+                                window, rel_eps, buf, changed, cnt, big, tpos[:0], buf[:0], tpos,
                                 piecewise, pown, explog, trig)
                     total += cnt[1]
                     if not ok:
