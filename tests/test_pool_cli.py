@@ -80,6 +80,7 @@ def test_pool_missing_data_folder(tmp_path, capsys):
     assert len(err) == 1 and "pool_setup.json" in err[0]
 
 
+@pytest.mark.slow  # a whole online run, about 12 s
 def test_pool_online_paved_window_only_run(tmp_path):
     js = tmp_path / "p.json"
     buf = io.StringIO()
