@@ -321,6 +321,7 @@ def test_solve_json_with_unbounded_and_empty_domains(tmp_path, capsys):
     assert data["consistent"] is False and data["domains"] == {"x": None, "y": None}
 
 
+@pytest.mark.slow  # a whole satellite run (in a fresh clone, the compile too)
 def test_satellite_data_is_never_truncated_silently(tmp_path, capsys):
     rows = _lines(LOADERS[0])[:42]
     f, js = tmp_path / "k40.csv", tmp_path / "s.json"
