@@ -42,6 +42,7 @@ def assert_keeps(positions: Interval, mines: Interval | None, truth: AuvTruth) -
         assert _inside(mines, truth.mines).all(), (mines, truth.mines)
 
 
+@pytest.mark.slow  # whole surveys, about 25 s on 2 cores
 @pytest.mark.parametrize("case", SURVEYS, ids=[f"seed{c[0]}-n{c[1]}" for c in SURVEYS])
 @pytest.mark.parametrize("form", ["best", "natural"])
 def test_tube_formulation_keeps_the_truth(case, form):

@@ -195,6 +195,7 @@ def test_unbounded_interval_bounds_are_accepted(tmp_path, name, cell, text, expe
     assert got == expected
 
 
+@pytest.mark.slow  # a whole satellite run, about 6 s
 def test_satellite_model_text_writes_unbounded_outputs(tmp_path):
     f = _variant(tmp_path, LOADERS[0], {(1, 1): "-inf", (1, 6): "inf"})
     text = sat.model_text(sat.load(f, k_max=2))
@@ -292,6 +293,7 @@ def test_the_json_convention():
         [[0.0, 1.0], None]]
 
 
+@pytest.mark.slow  # whole scenario runs, about 80 s for the seven
 @pytest.mark.parametrize("argv", [
     ["demo"],
     ["run", "satellite"],
@@ -319,6 +321,7 @@ def test_solve_json_with_unbounded_and_empty_domains(tmp_path, capsys):
     assert data["consistent"] is False and data["domains"] == {"x": None, "y": None}
 
 
+@pytest.mark.slow  # a whole satellite run (in a fresh clone, the compile too)
 def test_satellite_data_is_never_truncated_silently(tmp_path, capsys):
     rows = _lines(LOADERS[0])[:42]
     f, js = tmp_path / "k40.csv", tmp_path / "s.json"

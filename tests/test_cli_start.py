@@ -60,6 +60,7 @@ main(["solve", {model!r}])
 """
 
 
+@pytest.mark.slow  # subprocesses compiling with an empty cache, about 11 s
 def test_a_compiling_run_says_so_once_and_a_cached_run_does_not(tmp_path):
     model = tmp_path / "m.txt"
     model.write_text("x in [0, 1], y in [0, 1];\nConstraints\nx + y = 1.5, x * y >= 0.1;\n")

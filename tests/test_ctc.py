@@ -304,6 +304,7 @@ def assert_point_kept(result: Interval, box: Interval, p: dict[str, float], name
 # 4. soundness on random constraints
 # -------------------------------------------------------------------------------------------
 
+@pytest.mark.slow  # 300 examples, about 75 s on 2 cores
 @settings(max_examples=300, suppress_health_check=[HealthCheck.filter_too_much,
                                                    HealthCheck.too_slow])
 @given(scenarios())

@@ -22,6 +22,9 @@ from boundest.paving import Subpaving, image, sivia
 
 distributed = pytest.importorskip("distributed")
 
+#: Dask LocalClusters of worker processes: slow, run by `pytest -m slow` (and CI)
+pytestmark = pytest.mark.slow
+
 X, Y, Z = Var("x"), Var("y"), Var("z")
 SHELL = {"f": X**2 + Y**2 + Z**2 + 0.5 * X * Y, "y": Interval([1], [4])}
 CUBE = Interval([-3, -3, -3], [3, 3, 3])

@@ -26,6 +26,7 @@ for f in (engine._revise_piecewise, engine._revise_explog, engine._revise_trig,
 """
 
 
+@pytest.mark.slow  # a subprocess compiling with an empty cache, about 12 s
 def test_an_arithmetic_tape_compiles_no_transcendental_kernel(tmp_path):
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path))
     out = subprocess.run([sys.executable, "-c", SCRIPT], env=env, capture_output=True,

@@ -27,6 +27,7 @@ def pool_run(tmp_path_factory):
     return rc, out, js, buf.getvalue()
 
 
+@pytest.mark.slow  # a whole pool run (its kernels compile here in a fresh clone, about 40 s)
 def test_pool_command_runs_and_writes_strict_json(pool_run):
     rc, _, js, _ = pool_run
     assert rc == 0
@@ -46,6 +47,7 @@ def test_pool_command_runs_and_writes_strict_json(pool_run):
                for (lo, hi), c in zip(s["box"], s["centre"], strict=True))
 
 
+@pytest.mark.slow  # a whole pool run (its kernels compile here in a fresh clone, about 40 s)
 def test_pool_figures_and_table(pool_run):
     _, out, _, _ = pool_run
     for name in ("pool_snapshots", "pool_emission", "pool_trajectory"):
@@ -56,6 +58,7 @@ def test_pool_figures_and_table(pool_run):
     assert len(rows) == 11  # the header and 10 regular times
 
 
+@pytest.mark.slow  # a whole pool run (its kernels compile here in a fresh clone, about 40 s)
 def test_pool_summary_states_the_guarantee(pool_run):
     text = pool_run[3]
     assert "P(at most 4 outliers in 40 pings)" in text
@@ -80,6 +83,7 @@ def test_pool_missing_data_folder(tmp_path, capsys):
     assert len(err) == 1 and "pool_setup.json" in err[0]
 
 
+@pytest.mark.slow  # a whole online run, about 12 s
 def test_pool_online_paved_window_only_run(tmp_path):
     js = tmp_path / "p.json"
     buf = io.StringIO()

@@ -12,6 +12,7 @@ from boundest.cli import main
 from boundest.scenarios.pool_mc import wilson
 
 
+@pytest.mark.slow  # a whole Monte Carlo pool run
 def test_monte_carlo_command_writes_strict_json_table_and_figure(tmp_path, capsys):
     js = tmp_path / "mc.json"
     rc = main(["run", "pool", "--monte-carlo", "2", "--mc-chunk", "2", "--out", str(tmp_path),

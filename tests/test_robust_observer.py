@@ -48,6 +48,7 @@ def _inside(res, truth) -> np.ndarray:
     return ((res.boxes.lo <= truth.states) & (truth.states <= res.boxes.hi)).all(-1)
 
 
+@pytest.mark.slow  # about 20 s for the four cases
 @pytest.mark.parametrize(("q", "sweeps", "n"), [(4, 0, 48), (8, 0, 48), (4, 1, 6), (8, 1, 6)])
 def test_truth_kept_while_windows_hold_at_most_q_outliers(q, sweeps, n):
     data, truth = missions(11, n)
@@ -101,6 +102,7 @@ def test_online_updates_are_the_offline_run():
         obs.update(None, 0.0, data.ranges[60])
 
 
+@pytest.mark.slow  # about 11 s on 2 cores
 def test_paving_keeps_the_truth_and_tightens():
     data, truth = missions(21, 2)
     data = PoolData(data.t0, data.dt, data.inputs[:, :160], data.alpha[:160],

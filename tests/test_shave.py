@@ -100,6 +100,7 @@ def csps(draw):
     return model, n, pts
 
 
+@pytest.mark.slow  # about 30 s on 2 cores
 @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(csps(), st.sampled_from([Shaving(), Shaving(frac=0.05, probe_evals=40, rounds=4,
                                                    reach=1, min_gain=0.0)]))

@@ -235,6 +235,7 @@ def test_eval_with_jumps_keeps_truth(case, seed, u, dt, dz):
     assert keeps(y, jp.x, sample_times(t, rng))
 
 
+@pytest.mark.slow  # about 20 s on 2 cores
 @settings(max_examples=60, deadline=None)
 @given(cases(), seeds, st.floats(0, 1), st.floats(0, 1), st.floats(0, 0.2))
 def test_integrals_with_jumps_keep_truth(case, seed, a, b, r):
