@@ -330,4 +330,5 @@ def test_satellite_data_is_never_truncated_silently(tmp_path, capsys):
                  str(js)]) == 0
     assert _strict(js.read_text())["k_max"] == 40
     rc, err = _run(["run", "satellite", "--data", str(f), "--kmax", "200"], capsys)
+    err = [e for e in err if not e.startswith("boundest: compiling")]  # with an empty cache
     assert rc == 2 and len(err) == 1 and f"{f}:42: the file ends at k = 40" in err[0], err
