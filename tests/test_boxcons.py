@@ -4,10 +4,8 @@ and empty, unbounded, degenerate inputs."""
 
 from __future__ import annotations
 
-import math
 from fractions import Fraction
 
-import mpmath
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -17,76 +15,16 @@ from boundest import Interval
 from boundest.ctc import CtcBox, CtcFwdBwd, Fixpoint
 from boundest.ctc.boxcons import occurrences
 from boundest.expr import Model, Var
-from boundest.expr.functions import cos, sin, sqr
+from boundest.expr.functions import sqr
 
-X = [Var(f"x{i}") for i in range(3)]
+from .strategies import solvable_csps
+
 x, z = Var("x"), Var("z")
 
 
-def _tree(n: int):
-    """Random expression trees over ``x0..x{n-1}`` (nested tuples); with 2-3 variables and up
-    to 7 leaves, a variable occurring several times is the common case."""
-    leaf = st.one_of(st.integers(0, n - 1).map(lambda i: ("x", i)),
-                     st.sampled_from([0.5, 1.0, -2.0, 3.0]).map(lambda c: ("c", c)))
-
-    def grow(sub):
-        return st.one_of(
-            st.tuples(st.sampled_from(["add", "sub", "mul"]), sub, sub),
-            st.tuples(st.sampled_from(["sqr", "sin", "cos", "rat"]), sub))
-
-    return st.recursive(leaf, grow, max_leaves=7)
-
-
-def _expr(t):
-    k = t[0]
-    if k == "x":
-        return X[t[1]]
-    if k == "c":
-        return t[1]
-    a = [_expr(s) for s in t[1:]]
-    return {"add": lambda: a[0] + a[1], "sub": lambda: a[0] - a[1], "mul": lambda: a[0] * a[1],
-            "sqr": lambda: sqr(a[0]), "sin": lambda: sin(a[0]), "cos": lambda: cos(a[0]),
-            "rat": lambda: a[0] / (1.0 + sqr(a[0]))}[k]()
-
-
-def _value(t, p):
-    """The value of a tree at the point ``p`` in mpmath at 60 digits (the independent truth)."""
-    k = t[0]
-    if k == "x":
-        return mpmath.mpf(p[t[1]])
-    if k == "c":
-        return mpmath.mpf(t[1])
-    v = [_value(s, p) for s in t[1:]]
-    return {"add": lambda: v[0] + v[1], "sub": lambda: v[0] - v[1], "mul": lambda: v[0] * v[1],
-            "sqr": lambda: v[0] ** 2, "sin": lambda: mpmath.sin(v[0]),
-            "cos": lambda: mpmath.cos(v[0]), "rat": lambda: v[0] / (1 + v[0] ** 2)}[k]()
-
-
-def _outward(v, up: bool) -> float:
-    """A float beyond the mpmath value ``v`` (below it, or above when ``up``)."""
-    d = math.inf if up else -math.inf
-    return float(np.nextafter(np.nextafter(float(v), d), d))
-
-
-@st.composite
-def csps(draw):
-    """``y_j = f_j(x)``, ``x in [-2, 2]^n``, the domain of ``y_j`` the hull of ``f_j`` at a few
-    random points plus a margin: those points (with their exact images) are solutions."""
-    n = draw(st.integers(1, 3))
-    pts = draw(st.lists(st.tuples(*[st.floats(-2, 2) for _ in range(n)]), min_size=1,
-                        max_size=3))
-    trees = draw(st.lists(_tree(n), min_size=1, max_size=3))
-    margin = draw(st.sampled_from([0.0, 1e-9, 0.01, 0.3]))
-    mpmath.mp.dps = 60
-    model = Model()
-    for i in range(n):
-        model.declare(X[i], (-2.0, 2.0))
-    for j, t in enumerate(trees):
-        vals = [_value(t, p) for p in pts]
-        model.declare(Var(f"y{j}"), (_outward(min(vals) - margin, False),
-                                     _outward(max(vals) + margin, True)))
-        model.add(Var(f"y{j}") == _expr(t))
-    return model, n, pts
+def csps():
+    """Random CSPs whose sampled solutions are known (``strategies.solvable_csps``)."""
+    return solvable_csps((1, 3), 3, [0.0, 1e-9, 0.01, 0.3], 7)
 
 
 @settings(max_examples=120, deadline=None, suppress_health_check=[HealthCheck.too_slow])

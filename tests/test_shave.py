@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import math
 
-import mpmath
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -16,88 +15,14 @@ from boundest import Interval
 from boundest.csp import Shaving, propagate
 from boundest.ctc import CtcFwdBwd, CtcShave, Fixpoint
 from boundest.expr import Model, Var
-from boundest.expr.functions import cos, sin, sqr
+from boundest.expr.functions import sqr
 
-X = [Var(f"x{i}") for i in range(4)]
-
-
-def _tree(n: int):
-    """Random expression trees over ``x0..x{n-1}`` as nested tuples (several occurrences of a
-    variable are common: the dependency problem that shaving addresses)."""
-    leaf = st.one_of(st.integers(0, n - 1).map(lambda i: ("x", i)),
-                     st.sampled_from([0.5, 1.0, -2.0, 3.0]).map(lambda c: ("c", c)))
-
-    def grow(sub):
-        return st.one_of(
-            st.tuples(st.sampled_from(["add", "sub", "mul"]), sub, sub),
-            st.tuples(st.sampled_from(["sqr", "sin", "cos", "rat"]), sub))
-
-    return st.recursive(leaf, grow, max_leaves=6)
+from .strategies import solvable_csps
 
 
-def _expr(t):
-    """The boundest expression of a tree."""
-    k = t[0]
-    if k == "x":
-        return X[t[1]]
-    if k == "c":
-        return t[1]
-    args = [_expr(a) for a in t[1:]]
-    if k == "add":
-        return args[0] + args[1]
-    if k == "sub":
-        return args[0] - args[1]
-    if k == "mul":
-        return args[0] * args[1]
-    if k == "sqr":
-        return sqr(args[0])
-    if k == "sin":
-        return sin(args[0])
-    if k == "cos":
-        return cos(args[0])
-    return args[0] / (1.0 + sqr(args[0]))  # rat: several occurrences, a bounded image
-
-
-def _value(t, p):
-    """The value of a tree at the point ``p``, in mpmath at 60 digits (the independent truth)."""
-    k = t[0]
-    if k == "x":
-        return mpmath.mpf(p[t[1]])
-    if k == "c":
-        return mpmath.mpf(t[1])
-    v = [_value(a, p) for a in t[1:]]
-    return {"add": lambda: v[0] + v[1], "sub": lambda: v[0] - v[1], "mul": lambda: v[0] * v[1],
-            "sqr": lambda: v[0] ** 2, "sin": lambda: mpmath.sin(v[0]),
-            "cos": lambda: mpmath.cos(v[0]), "rat": lambda: v[0] / (1 + v[0] ** 2)}[k]()
-
-
-def _outward(v, up: bool) -> float:
-    """A float beyond the mpmath value ``v`` (below it, or above when ``up``)."""
-    f = float(v)
-    return float(np.nextafter(np.nextafter(f, math.inf if up else -math.inf),
-                              math.inf if up else -math.inf))
-
-
-@st.composite
-def csps(draw):
-    """A CSP ``y_j = f_j(x)``, ``x in [-2, 2]^n``, whose ``y_j`` domains are the hull of
-    ``f_j`` over a few random points (plus a random margin): those points are solutions."""
-    n = draw(st.integers(2, 4))
-    pts = draw(st.lists(st.tuples(*[st.floats(-2, 2) for _ in range(n)]), min_size=1,
-                        max_size=3))
-    trees = draw(st.lists(_tree(n), min_size=1, max_size=4))
-    margin = draw(st.sampled_from([0.0, 1e-6, 0.01, 0.3]))
-    mpmath.mp.dps = 60
-    model = Model()
-    for i in range(n):
-        model.declare(X[i], (-2.0, 2.0))
-    for j, t in enumerate(trees):
-        vals = [_value(t, p) for p in pts]
-        y = Var(f"y{j}")
-        model.declare(y, (_outward(min(vals) - margin, False), _outward(max(vals) + margin,
-                                                                        True)))
-        model.add(y == _expr(t))
-    return model, n, pts
+def csps():
+    """Random CSPs whose sampled solutions are known (``strategies.solvable_csps``)."""
+    return solvable_csps((2, 4), 4, [0.0, 1e-6, 0.01, 0.3], 6)
 
 
 @pytest.mark.slow  # about 30 s on 2 cores
