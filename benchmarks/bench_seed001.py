@@ -12,7 +12,9 @@ Codac 1.5.7 (``benchmarks/seed001_codac.py``, run as a subprocess with
 with speed-ups (Codac time / boundest time) and width ratios (Codac / boundest: > 1 means
 boundest is tighter).
 
-Cases: the robot at each ``--dts`` (default 0.01 and 0.001) on Table 1, and the clock at each
+Cases: the robot at each ``--dts`` (default 0.01 and 0.001) and each ``--rates`` (the forms of
+the distance rate: ``both``, the default of ``range_only.solve``, and ``bearing``, the network
+of Rohou et al. 2018; Codac runs the same network in each case) on Table 1, and the clock at each
 ``--clock-dts`` (default 0.01 and 0.002) on Table 2 over ``[0, t_final]`` (12.44 s for Table 2
 at dt = 0.01). The paper's
 truths (robot: x(0) = (0, 0, pi/2, 0) with the centre of eq. 14; clock: eq. 16) are checked
@@ -83,11 +85,11 @@ def _other_mode(solve: Any, width: Any, repeat: int) -> dict:
             "iterations": res.iterations, **width(res)}
 
 
-def _bench_robot(ro: Any, dt: float, repeat: int) -> tuple[dict, Any]:
+def _bench_robot(ro: Any, dt: float, repeat: int, rate: str) -> tuple[dict, Any]:
     t0 = time.perf_counter()
-    first = ro.solve(dt=dt, progress=False)
+    first = ro.solve(dt=dt, progress=False, rate=rate)
     first_wall = time.perf_counter() - t0
-    times, res = _timed(lambda: ro.solve(dt=dt, progress=False), repeat)
+    times, res = _timed(lambda: ro.solve(dt=dt, progress=False, rate=rate), repeat)
     d = res.position_diagonal()
     s = res.x.t
     truth = ro.RobotTruth().states(s)
@@ -104,9 +106,10 @@ def _bench_robot(ro: Any, dt: float, repeat: int) -> tuple[dict, Any]:
            "t_i": [[_r(float(a), 4), _r(float(b), 4)] for a, b in zip(res.t.lo, res.t.hi,
                                                                       strict=True)],
            "contains_truth": bool(np.all(res.x.gates.contains(truth))),
-           "time_deriv": res.time_deriv,
+           "time_deriv": res.time_deriv, "rate": rate,
            "other_mode": _other_mode(
-               lambda: ro.solve(dt=dt, progress=False, time_deriv=not res.time_deriv),
+               lambda: ro.solve(dt=dt, progress=False, time_deriv=not res.time_deriv,
+                                rate=rate),
                lambda r: {"mean_diagonal_m": float(np.mean(r.position_diagonal())),
                           "t_width_sum": float(np.sum(r.t.width()))}, min(repeat, 3))}
     return rec, res
@@ -140,21 +143,26 @@ def _bench_clock(dc: Any, dt: float, repeat: int) -> tuple[dict, Any]:
     return rec, res
 
 
+def _robot_label(dt: float, rate: str) -> str:
+    return f"robot dt={dt:g} rate={rate}"
+
+
 # -- Codac (subprocess) ----------------------------------------------------------------------
-def _codac_spec(ro: Any, dc: Any, dts: list[float], clock: list[dict],
+def _codac_spec(ro: Any, dc: Any, robot: list[dict], clock: list[dict],
                 args: argparse.Namespace) -> dict:
     meas = ro.load()
     x3_0, x4_0 = ro.initial_heading_speed()
     b = (meas.beacons.lo + meas.beacons.hi) / 2
-    cases = [{"kind": "robot", "label": f"robot dt={dt:g}", "dt": float(dt).hex(),
+    cases = [{"kind": "robot", "label": _robot_label(row["dt"], row["rate"]),
+              "rate": row["rate"], "dt": float(row["dt"]).hex(),
               "t0": float(ro.T0).hex(), "tf": float(ro.TF).hex(),
               "u_bound": float(ro.U_BOUND).hex(),
               "x3_0": _h([x3_0.lo, x3_0.hi]), "x4_0": _h([x4_0.lo, x4_0.hi]),
               "beacons": [_h(row) for row in b], "beacon": [int(k) for k in meas.beacon],
               "t_lo": _h(meas.t.lo), "t_hi": _h(meas.t.hi), "z_lo": _h(meas.z.lo),
               "z_hi": _h(meas.z.hi), "rel_eps": float(args.rel_eps).hex(), "max_iter": 200,
-              "every": max(1, round(0.1 / dt))}
-             for dt in dts]
+              "every": max(1, round(0.1 / row["dt"]))}
+             for row in robot]
     cm = dc.load()
     cases += [{"kind": "clock", "label": f"clock dt={row['dt']:g}",
                "dt": float(row["dt"]).hex(), "tf": float(row["boundest"]["tf"]).hex(),
@@ -243,6 +251,9 @@ def _machine() -> dict:
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--dts", default="0.01,0.001", help="robot slice durations")
+    p.add_argument("--rates", default="both,bearing",
+                   help="forms of the robot's distance rate (range_only.RATE_FORMS), each run "
+                        "by both libraries")
     p.add_argument("--clock-dts", default="0.01,0.002", help="clock slice durations")
     p.add_argument("--repeat", type=int, default=5, help="boundest runs per case (median)")
     p.add_argument("--repeat-slow", type=int, default=3,
@@ -272,14 +283,16 @@ def main() -> None:
     load_start = list(os.getloadavg()) if hasattr(os, "getloadavg") else None
     robot, results = [], {}
     for dt in dts:
-        t0 = time.perf_counter()
-        ro.solve(dt=dt, progress=False)      # warm-up (first call also loads the kernels)
-        slow = time.perf_counter() - t0 > 10
-        rec, res = _bench_robot(ro, dt, args.repeat_slow if slow else args.repeat)
-        print(f"boundest robot dt={dt:g}: {rec['time_s']:.3f} s, {rec['iterations']} "
-              f"iterations, mean d {rec['mean_diagonal_m']:.3f} m", file=sys.stderr)
-        robot.append({"dt": dt, "boundest": rec})
-        results[f"robot dt={dt:g}"] = res
+        for rate in [v for v in args.rates.split(",") if v]:
+            t0 = time.perf_counter()
+            ro.solve(dt=dt, progress=False, rate=rate)  # warm-up (the first also loads kernels)
+            slow = time.perf_counter() - t0 > 10
+            rec, res = _bench_robot(ro, dt, args.repeat_slow if slow else args.repeat, rate)
+            print(f"boundest robot dt={dt:g} rate={rate}: {rec['time_s']:.3f} s, "
+                  f"{rec['iterations']} iterations, mean d {rec['mean_diagonal_m']:.3f} m",
+                  file=sys.stderr)
+            robot.append({"dt": dt, "rate": rate, "boundest": rec})
+            results[_robot_label(dt, rate)] = res
     clock_dts = [0.01] if args.quick else [float(v) for v in args.clock_dts.split(",")]
     clock = []
     for dt in clock_dts:
@@ -297,14 +310,15 @@ def main() -> None:
         codac_info["skipped"] = f"{python} not found (see benchmarks/README.md)"
     else:
         try:
-            out = run_json_script(python, CODAC_SCRIPT, _codac_spec(ro, dc, dts, clock, args),
+            out = run_json_script(python, CODAC_SCRIPT, _codac_spec(ro, dc, robot, clock, args),
                                   args.codac_timeout)
             codac_info = {k: out[k] for k in ("codac_version", "python", "import_s",
                                               "fegetround_before_import",
                                               "fegetround_after_import", "subprocess_wall_s")}
             for rec in out["results"]:
                 if rec["label"].startswith("robot"):
-                    row = next(r for r in robot if f"robot dt={r['dt']:g}" == rec["label"])
+                    row = next(r for r in robot
+                               if _robot_label(r["dt"], r["rate"]) == rec["label"])
                     row.setdefault("codac", []).append(_codac_robot_row(
                         rec, row["boundest"], results[rec["label"]], ro))
                 else:
@@ -317,7 +331,7 @@ def main() -> None:
     table = []
     for row in robot:
         b = row["boundest"]
-        line = {"case": f"robot dt={row['dt']:g}", "boundest_s": _r(b["time_s"]),
+        line = {"case": _robot_label(row["dt"], row["rate"]), "boundest_s": _r(b["time_s"]),
                 "iterations": b["iterations"], "mean_d_m": _r(b["mean_diagonal_m"]),
                 "t_contracted": b["t_contracted"], "time_deriv": b["time_deriv"],
                 "other_mode_s": _r(b["other_mode"]["time_s"]),

@@ -14,6 +14,7 @@ range-only robot::
     CtcFunction  v = f(x, u)                                   (equation 13)
     CtcDeriv     x' = v
     CtcFunction  y_k = |x_12 - b_k|,  w_k = x4 cos(x3 - atan2(x2 - b_k2, x1 - b_k1))
+    CtcFunction  w_k y_k = (x_12 - b_k).v_12                     (case "rate": "both" only)
     CtcDeriv     y_k' = w_k
     CtcEval      z_i = y_k(t_i)                                one per measurement
 
@@ -122,8 +123,12 @@ def main() -> None:
         # y_k = |x_12 - b_k| and its derivative w_k = x4 cos(x3 - theta_k), theta_k the bearing
         # of the robot from b_k: (x - b).v / |x - b| written so that |w_k| <= |x4| even while
         # the position is unbounded (the quotient form gives nothing then)
+        # with rate "both", also the product form w_k y_k = (x_12 - b_k).v_12
+        both = case.get("rate", "bearing") == "both"
         g_src = [f"(y - sqrt((x1-({bx!r}))^2+(x2-({by!r}))^2) ; "
-                 f"w - x4*cos(x3-atan2(x2-({by!r}),x1-({bx!r}))))" for bx, by in case["beacons"]]
+                 f"w - x4*cos(x3-atan2(x2-({by!r}),x1-({bx!r})))"
+                 + (f" ; w*y - ((x1-({bx!r}))*v1 + (x2-({by!r}))*v2)" if both else "") + ")"
+                 for bx, by in case["beacons"]]
         ts = [Interval(a, b) for a, b in zip(case["t_lo"], case["t_hi"], strict=True)]
         zs = [Interval(a, b) for a, b in zip(case["z_lo"], case["z_hi"], strict=True)]
         beacon = case["beacon"]
@@ -139,7 +144,8 @@ def main() -> None:
             for src, y, w in zip(g_src, ys, ws, strict=True):
                 g = Function("y", "w", "x[4]", "v[4]",
                              src.replace("x1", "x[0]").replace("x2", "x[1]")
-                             .replace("x3", "x[2]").replace("x4", "x[3]"))
+                             .replace("x3", "x[2]").replace("x4", "x[3]")
+                             .replace("v1", "v[0]").replace("v2", "v[1]"))
                 keep += [g, CtcFunction(g)]
                 cn.add(keep[-1], [y, w, x, v])
             for k, ti, zi in zip(beacon, ts, zs, strict=True):
@@ -154,7 +160,11 @@ def main() -> None:
             rate = [Function("w", "x1", "x2", "x3", "x4",
                              f"w - x4*cos(x3-atan2(x2-({by!r}),x1-({bx!r})))")
                     for bx, by in case["beacons"]]
+            prod = [Function("w", "y", "x1", "x2", "v1", "v2",
+                             f"w*y - ((x1-({bx!r}))*v1 + (x2-({by!r}))*v2)")
+                    for bx, by in case["beacons"]]
             cd, cr = [CtcFunction(g) for g in dist], [CtcFunction(g) for g in rate]
+            cp = [CtcFunction(g) for g in prod]
 
             def dead_reckoning() -> None:
                 cf[0].contract(v[0], x[2], x[3])
@@ -168,6 +178,8 @@ def main() -> None:
                 for k, (y, w) in enumerate(zip(ys, ws, strict=True)):
                     cd[k].contract(y, x[0], x[1])
                     cr[k].contract(w, x[0], x[1], x[2], x[3])
+                    if both:
+                        cp[k].contract(w, y, x[0], x[1], v[0], v[1])
                     ctc_deriv.contract(y, w)
                 for k, ti, zi in zip(beacon, ts, zs, strict=True):
                     ctc_eval.contract(ti, zi, ys[k], ws[k])

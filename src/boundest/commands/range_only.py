@@ -22,7 +22,8 @@ def run(args: argparse.Namespace) -> int:
     print(f"tubes over [{ro.T0:g}, {ro.TF:g}] with dt = {args.dt:g} ({n} slices) ...",
           flush=True)
     res = ro.solve(meas, dt=args.dt, rel_eps=args.rel_eps, max_iter=args.max_iter,
-                   time_deriv=args.time_deriv_eval)
+                   time_deriv=args.time_deriv_eval,
+                   rate="bearing" if args.bearing_rate else "both")
     if res.empty:
         print(f"proven INCONSISTENT after {res.iterations} iterations: no trajectory of the "
               "model meets every measurement")
@@ -31,6 +32,10 @@ def run(args: argparse.Namespace) -> int:
         state = "fixed point reached" if res.converged else "stopped at --max-iter"
         print(f"{state}: {res.iterations} iterations in {res.time_s:.3f} s "
               f"(building {res.build_s:.3f} s)")
+        print("  distance rate constrained in "
+              + ("the bearing form only (--bearing-rate: cheaper, wider)" if args.bearing_rate
+                 else "both forms, bearing and product (about 20 % more time than "
+                      "--bearing-rate, mean diagonal 3 % smaller on Table 1)"))
         print("  mean position-box diagonal d per iteration: "
               + ", ".join(f"{float(np.mean(r)):.2f}" for r in res.diag))
         print(f"  final d: mean {float(np.mean(d)):.2f} m, max {float(np.max(d)):.2f} m")
@@ -67,6 +72,9 @@ def register(runs: argparse._SubParsersAction) -> None:
     p.add_argument("--time-deriv-eval", action="store_true",
                    help="contract the measurement times with the derivative inside the slices "
                         "(default: the plain tube inverse; the same result on Table 1)")
+    p.add_argument("--bearing-rate", action="store_true",
+                   help="constrain the distance rate in its bearing form only, as Rohou et al. "
+                        "2018 and Codac (cheaper, wider; default: also the product form)")
     p.add_argument("--out", default="out", help="folder for figures (default: out)")
     p.add_argument("--json", help="write the tubes and measurement boxes as JSON to this file "
                    "(strict JSON: docs/json.md)")

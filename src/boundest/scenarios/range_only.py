@@ -11,13 +11,18 @@ the position unknown. Range measurements ``z_i = |x12(t_i) - b_k|`` to three bea
 
     v = f(x, u),  x' = v,
     y_k = |x12 - b_k|,  w_k = x4 cos(x3 - atan2(x2 - b_k2, x1 - b_k1)),  y_k' = w_k,
+    w_k y_k = (x12 - b_k).v12,
     z_i = y_k(t_i)                                          (CtcEval, uncertain t_i)
 
-``w_k`` is the derivative of the distance, ``(x12 - b_k).v12 / y_k`` of the paper, written with
-the bearing of the robot from the beacon: the two are equal wherever ``x12 != b_k``, and this
-form gives ``|w_k| <= |x4|`` even while the position is still unbounded (the quotient form gives
-nothing then, and no measurement could ever be used). The truth used by the paper starts at
-``x(0) = (0, 0, pi/2, 0)`` with the centre of equation 14 as input.
+``w_k`` is the derivative of the distance, ``(x12 - b_k).v12 / y_k`` of the paper. It is
+constrained in two forms that are equal wherever ``x12 != b_k``: with the bearing of the robot
+from the beacon, which gives ``|w_k| <= |x4|`` even while the position is still unbounded (the
+paper's quotient gives nothing then, and no measurement could ever be used), and as the product
+``w_k y_k = (x12 - b_k).v12``, the tighter of the two once the position box is small (the
+bearing of a box seen from the beacon is wide; the dot product uses ``v12`` directly). Together
+they bring the mean position-box diagonal at ``dt = 0.01`` from 10.48 m (the bearing form
+alone, which is also what Codac 1.5.7 gets with it) to 10.18 m. The truth used by the paper
+starts at ``x(0) = (0, 0, pi/2, 0)`` with the centre of equation 14 as input.
 """
 
 from __future__ import annotations
@@ -38,6 +43,7 @@ from ..tube import ContractorNetwork, CtcDeriv, CtcEval, CtcSlices, Tube, time_g
 from ._data import check_index, check_sorted, embedded, outward, read_csv
 
 __all__ = [
+    "RATE_FORMS",
     "T0",
     "TF",
     "U_BOUND",
@@ -281,6 +287,7 @@ class RangeOnlyResult:
     diag_t: NDArray[np.float64]
     diag: list[NDArray[np.float64]]
     time_deriv: bool = False
+    rate: str = "both"
 
     @property
     def consistent(self) -> bool:
@@ -314,6 +321,7 @@ class RangeOnlyResult:
             "build_s": self.build_s,
             "n_slices": self.x.n_slices,
             "ctc_eval": "time-deriv" if self.time_deriv else "plain",
+            "rate_forms": self.rate,
             "contraction": fl(self.contraction),
             "t": fl(self.x.t),
             "x_lo": fl(self.x.gates.lo),
@@ -349,7 +357,12 @@ class _Network:
     position: ContractorNetwork
 
 
-def _network(meas: Measurements, t: NDArray[np.float64], time_deriv: bool = False) -> _Network:
+#: The forms of the distance rate ``w_k`` that ``solve`` can constrain (see the module docstring).
+RATE_FORMS = ("both", "bearing")
+
+
+def _network(meas: Measurements, t: NDArray[np.float64], time_deriv: bool = False,
+             rate: str = "both") -> _Network:
     n_b = meas.beacons.shape[0]
     full = Interval.entire(4)
     x = Tube(t, Interval._new(np.broadcast_to(full.lo, (t.size - 1, 4)).copy(),
@@ -367,13 +380,18 @@ def _network(meas: Measurements, t: NDArray[np.float64], time_deriv: bool = Fals
                                                         "y", "w"))
     evolution = CtcSlices([v1 == x4 * ef.cos(x3), v2 == x4 * ef.sin(x3), v3 == u1, v4 == u2],
                           ["x3", "x4", "v1", "v2", "v3", "v4", "u1", "u2"])
-    distance, rate = [], []
+    distance, rates = [], []
     for k in range(n_b):
         bx, by = meas.beacons[k, 0], meas.beacons[k, 1]
         dx, dy = x1 - bx, x2 - by
         distance.append(CtcSlices([yk == ef.sqrt(ef.sqr(dx) + ef.sqr(dy))], ["x1", "x2", "y"]))
-        rate.append(CtcSlices([wk == x4 * ef.cos(x3 - ef.atan2(dy, dx))],
-                              ["x1", "x2", "x3", "x4", "w"]))
+        bearing = wk == x4 * ef.cos(x3 - ef.atan2(dy, dx))
+        if rate == "both":
+            rates.append((CtcSlices([bearing, wk * yk == dx * v1 + dy * v2],
+                                    ["x1", "x2", "x3", "x4", "v1", "v2", "y", "w"]),
+                          [x, v[0], v[1], y[k], w[k]]))
+        else:
+            rates.append((CtcSlices([bearing], ["x1", "x2", "x3", "x4", "w"]), [x, w[k]]))
     t_meas, z_meas = meas.t.copy(), meas.z.copy()
     deriv = CtcDeriv()
     dead = ContractorNetwork()
@@ -383,7 +401,7 @@ def _network(meas: Measurements, t: NDArray[np.float64], time_deriv: bool = Fals
     pos.add(deriv, [x, v])
     for k in range(n_b):
         pos.add(distance[k], [x[0], x[1], y[k]])
-        pos.add(rate[k], [x, w[k]])
+        pos.add(*rates[k])
     pos.add(deriv, [y, w])
     ctc_eval = CtcEval(time_deriv)
     for i in range(len(meas)):
@@ -395,17 +413,18 @@ def _network(meas: Measurements, t: NDArray[np.float64], time_deriv: bool = Fals
 
 
 def solve(meas: Measurements | None = None, dt: float = 0.01, rel_eps: float = 1e-4,
-          max_iter: int = 200, progress: bool | None = None, time_deriv: bool = False
-          ) -> RangeOnlyResult:
+          max_iter: int = 200, progress: bool | None = None, time_deriv: bool = False,
+          rate: str = "both") -> RangeOnlyResult:
     """Contract CN (15) to its fixed point over ``[T0, TF]`` sliced every ``dt``.
 
     The network splits in two. Dead reckoning, ``v = f(x, u)`` and ``x' = v``, determines the
     heading, the speed and ``[v]`` from ``[u]`` and the initial conditions alone; it is run to
-    its fixed point first. Its domains are then final: in the rest of the network only
-    ``w_k = x4 cos(x3 - theta_k)`` involves ``x3``, ``x4``, and ``[w_k]`` is never narrowed
-    except by that constraint itself, so projecting it back cannot narrow them (and ``x' = v``
-    is already consistent on them). The position network is then iterated, in order: ``x' = v``,
-    the distance ``y_k`` and its rate ``w_k`` for every beacon, ``y' = w``, one ``CtcEval`` per
+    its fixed point first and not again: the position network can still narrow ``[v12]``
+    (through ``w_k y_k = (x12 - b_k).v12``), but the heading and speed are not recomputed from
+    it (sound; the whole network's fixed point could be a little tighter). The position
+    network is then iterated, in order: ``x' = v``,
+    the distance ``y_k`` and its rate ``w_k`` (both forms) for every beacon, ``y' = w``, one
+    ``CtcEval`` per
     measurement, and the distances again (to carry the measurements back to the position). It
     stops when an iteration decreases the total width of its domains by less than ``rel_eps``
     (relative) while bounding no new bound, after ``max_iter`` iterations, or when a domain
@@ -415,13 +434,20 @@ def solve(meas: Measurements | None = None, dt: float = 0.01, rel_eps: float = 1
     ``time_deriv``: contract the measurement times with the derivative in :class:`CtcEval`
     (``False``, the default: the plain tube inverse; on Table 1 at ``dt = 0.01`` both give the
     same tubes and the same ``[t_i]``, at the same cost, so the simpler one is kept).
+
+    ``rate``: ``"both"`` (default) constrains the distance rate ``w_k`` with the bearing form
+    and the product form ``w_k y_k = (x12 - b_k).v12``; ``"bearing"`` with the bearing form
+    only, the network of Rohou et al. 2018 and of the Codac comparison (cheaper, wider: on
+    Table 1 at ``dt = 0.01``, mean diagonal 10.48 m against 10.18 m).
     """
     meas = load() if meas is None else meas
     if not (np.isfinite(dt) and dt > 0):
         raise ValueError(f"dt must be a positive number, got {dt!r}")
+    if rate not in RATE_FORMS:
+        raise ValueError(f"rate must be one of {', '.join(RATE_FORMS)}, got {rate!r}")
     start = time.perf_counter()
     t = time_grid(T0, TF, dt)
-    net = _network(meas, t, time_deriv)
+    net = _network(meas, t, time_deriv, rate)
     build_s = time.perf_counter() - start
     step = max(1, round(0.1 / dt))
     diag_t = t[::step]
@@ -453,4 +479,4 @@ def solve(meas: Measurements | None = None, dt: float = 0.01, rel_eps: float = 1
     spent = time.perf_counter() - start
     return RangeOnlyResult(meas, net.x, net.v, net.y, net.w, net.t, net.z, iterations,
                            converged, empty, spent, build_s, contraction, diag_t, diag,
-                           time_deriv)
+                           time_deriv, rate)
