@@ -1,9 +1,9 @@
 """The forward-backward contractor (HC4-revise) on a tape, batched over boxes.
 
 One pass evaluates every node forward (``z = z ∩ f(x, y)``, in tape order) then projects
-backward (``(x, y) = f_rev(z, x, y)``, in reverse order). The whole batch is one compiled call:
-a loop over the boxes running :func:`boundest.ctc.revise.hc4_fwdbwd` on each box's slots, with
-only the op families of the tape compiled in.
+backward (``(x, y) = f_rev(z, x, y)``, in reverse order). The whole batch is one compiled call
+that revises each node over all the boxes with :func:`boundest.ctc.revise.revise_steps` (the
+node kernels of the propagation engine), with only the op families of the tape compiled in.
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ from ..expr.nodes import Constraint
 from ..expr.tape import OPS, Tape, compile_model
 from ..interval import Interval
 from .base import Contractor
-from .revise import family_flags, hc4_fwdbwd
+from .revise import family_flags, revise_steps
 
 __all__ = ["FORWARD", "CtcFwdBwd"]
 
@@ -90,34 +90,67 @@ def _contract_rows(op, out, a, b, param, tlo, thi, slots, xlo, xhi, piecewise, p
                    trig):
     """One forward-backward pass on each box (row) of ``xlo``/``xhi`` (``(rows, n)``; box
     component ``j`` is slot ``slots[j]`` of the tape, whose initial domains are ``tlo``/``thi``).
-    Returns the contracted boxes; a box with one empty slot is empty (all NaN)."""
+    Returns the contracted boxes; a box with one empty slot is empty (all NaN).
+
+    The slots are laid out ``(n_slots, rows)`` and each node is revised over all rows before
+    the next: consecutive revisions are independent, so they overlap in the processor, where a
+    loop over the rows, each running the whole tape, waits on every node's result before the
+    next (measured about 1.5 times slower on the range-only scenario's tapes). The boxes are
+    still independent: a row that becomes empty is only marked, its later values are unused.
+    """
     rows, n = xlo.shape
+    m = tlo.size
+    lo = np.empty((m, rows))
+    hi = np.empty((m, rows))
+    ok = np.ones(rows, dtype=np.bool_)
+    buf = np.empty(4)
+    for s in range(m):
+        lo[s, :] = tlo[s]
+        hi[s, :] = thi[s]
+        if not tlo[s] <= thi[s]:  # an empty (NaN) domain: no box has a solution
+            ok[:] = False
+    for j in range(n):  # several box components may share a slot
+        s = slots[j]
+        for r in range(rows):
+            vl, vh = xlo[r, j], xhi[r, j]
+            if vl <= vh:
+                lo[s, r] = max(lo[s, r], vl)
+                hi[s, r] = min(hi[s, r], vh)
+                ok[r] &= lo[s, r] <= hi[s, r]
+            else:
+                ok[r] = False
+    for i in range(op.size):  # forward: z ∩= f(x, y)
+        code, o, ia, ib, p = op[i], out[i], a[i], b[i], param[i]
+        for r in range(rows):
+            yl, yh = (lo[ib, r], hi[ib, r]) if ib >= 0 else (0.0, 0.0)
+            zl, zh, _, _, _, _ = revise_steps(code, lo[o, r], hi[o, r], lo[ia, r], hi[ia, r],
+                                              yl, yh, p, buf, True, None, piecewise, pown,
+                                              explog, trig)
+            ok[r] &= _meet(lo, hi, o, r, zl, zh)
+    for i in range(op.size - 1, -1, -1):  # backward: (x, y) ∩= f_rev(z, x, y)
+        code, o, ia, ib, p = op[i], out[i], a[i], b[i], param[i]
+        for r in range(rows):
+            yl, yh = (lo[ib, r], hi[ib, r]) if ib >= 0 else (0.0, 0.0)
+            _, _, xl, xh, yl, yh = revise_steps(code, lo[o, r], hi[o, r], lo[ia, r], hi[ia, r],
+                                                yl, yh, p, buf, None, True, piecewise, pown,
+                                                explog, trig)
+            ok[r] &= _meet(lo, hi, ia, r, xl, xh)
+            if ib >= 0:
+                ok[r] &= _meet(lo, hi, ib, r, yl, yh)
     rlo = np.empty((rows, n))
     rhi = np.empty((rows, n))
-    slo = np.empty(tlo.size)
-    shi = np.empty(tlo.size)
-    buf = np.empty(4)
-    tape_ok = True
-    for s in range(tlo.size):
-        tape_ok = tape_ok and tlo[s] <= thi[s]  # False for NaN (empty) domains
     for r in range(rows):
-        ok = tape_ok
-        if ok:
-            slo[:] = tlo
-            shi[:] = thi
-            for j in range(n):  # several box components may share a slot
-                s, vl, vh = slots[j], xlo[r, j], xhi[r, j]
-                if not vl <= vh:
-                    ok = False
-                    break
-                slo[s] = max(slo[s], vl)
-                shi[s] = min(shi[s], vh)
-        if ok:
-            for j in range(n):
-                ok = ok and slo[slots[j]] <= shi[slots[j]]
-        if ok:
-            ok = hc4_fwdbwd(op, out, a, b, param, slo, shi, buf, piecewise, pown, explog, trig)
         for j in range(n):
-            rlo[r, j] = slo[slots[j]] if ok else np.nan
-            rhi[r, j] = shi[slots[j]] if ok else np.nan
+            rlo[r, j] = lo[slots[j], r] if ok[r] else np.nan
+            rhi[r, j] = hi[slots[j], r] if ok[r] else np.nan
     return rlo, rhi
+
+
+@nb.njit(cache=True, inline="always", error_model="numpy")
+def _meet(lo, hi, s, r, nl, nh):
+    """``slot s of row r ∩= [nl, nh]``; False when the result is empty (NaN bounds are
+    empty)."""
+    nl = max(nl, lo[s, r]) if nl == nl else nl
+    nh = min(nh, hi[s, r]) if nh == nh else nh
+    lo[s, r], hi[s, r] = nl, nh
+    return nl <= nh

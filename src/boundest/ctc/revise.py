@@ -5,9 +5,9 @@ contractors (:class:`boundest.ctc.CtcRayCast`) share: ``revise`` contracts the t
 one node ``z = f(x, y)`` (``z ∩= f(x, y)``, then ``(x, y) = f_rev(z, x, y)``), ``hc4_pass``
 revises every node of a tape once forward and once backward on one box's slots. The ops are in
 families (:data:`FAMILIES`); a caller passes ``True`` for the families its tape uses and
-``None`` for the others, whose kernels Numba then neither compiles nor loads. ``hc4_fwdbwd``
-is the classic HC4 pass (all images forward, then all projections backward) that
-:class:`boundest.ctc.CtcFwdBwd` runs on each box of a batch.
+``None`` for the others, whose kernels Numba then neither compiles nor loads.
+``revise_steps`` runs one of the two steps of a revision alone: :class:`boundest.ctc.CtcFwdBwd`
+runs the classic HC4 pass with it (every image forward, then every projection backward).
 """
 
 from __future__ import annotations
@@ -23,8 +23,7 @@ from ..interval import arith as ar
 from ..interval import explog as el
 from ..interval import trig as tr
 
-__all__ = ["FAMILIES", "OP_CODES", "family_flags", "hc4_fwdbwd", "hc4_pass", "revise",
-           "revise_steps"]
+__all__ = ["FAMILIES", "OP_CODES", "family_flags", "hc4_pass", "revise", "revise_steps"]
 
 OP_CODES = _C = {name: i for i, name in enumerate(OPS)}
 NEG, SQR, SQRT, EXP, LOG, SIN, COS, TAN = (_C[k] for k in
@@ -88,7 +87,7 @@ def _cap(zl, zh, nl, nh):
 # The steps of a revision: each kernel below takes ``img`` and ``prj``, ``True`` or ``None``.
 # With ``img`` it intersects ``z`` with the image ``f(x, y)``, with ``prj`` it then projects
 # ``z`` back onto ``(x, y)``; Numba prunes the step given ``None`` before compiling, so
-# ``revise`` (both steps) and the two passes of ``hc4_fwdbwd`` (one step each) share one
+# ``revise`` (both steps) and the two sweeps of ``CtcFwdBwd`` (one step each) share one
 # implementation of every op.
 
 
@@ -318,38 +317,6 @@ def hc4_pass(op, out, a, b, param, lo, hi, buf, piecewise, pown, explog, trig):
         zl, zh, xl, xh, yl, yh = revise(op[i], lo[o], hi[o], lo[ia], hi[ia], yl, yh, param[i],
                                         buf, piecewise, pown, explog, trig)
         if not (_meet(lo, hi, o, zl, zh) and _meet(lo, hi, ia, xl, xh)):
-            return False
-        if ib >= 0 and not _meet(lo, hi, ib, yl, yh):
-            return False
-    return True
-
-
-@nb.njit(cache=True, error_model="numpy")
-def hc4_fwdbwd(op, out, a, b, param, lo, hi, buf, piecewise, pown, explog, trig):
-    """One HC4 forward-backward pass of a tape on the slots ``lo``/``hi`` (in place; the family
-    flags as in :func:`revise`): every node's image in order ``0..n-1`` (``z ∩= f(x, y)``),
-    then every node's projection in order ``n-1..0`` (``(x, y) ∩= f_rev(z, x, y)``).
-
-    Half the work of :func:`hc4_pass`, which revises each node fully on both sweeps (and
-    contracts at least as much). Returns False as soon as a slot becomes empty (the slots are
-    then partly updated: the box has no solution), True otherwise.
-    """
-    n = op.size
-    for i in range(n):
-        o, ia, ib = out[i], a[i], b[i]
-        yl, yh = (lo[ib], hi[ib]) if ib >= 0 else (0.0, 0.0)
-        zl, zh, _, _, _, _ = revise_steps(op[i], lo[o], hi[o], lo[ia], hi[ia], yl, yh,
-                                          param[i], buf, True, None, piecewise, pown, explog,
-                                          trig)
-        if not _meet(lo, hi, o, zl, zh):
-            return False
-    for i in range(n - 1, -1, -1):
-        o, ia, ib = out[i], a[i], b[i]
-        yl, yh = (lo[ib], hi[ib]) if ib >= 0 else (0.0, 0.0)
-        _, _, xl, xh, yl, yh = revise_steps(op[i], lo[o], hi[o], lo[ia], hi[ia], yl, yh,
-                                            param[i], buf, None, True, piecewise, pown, explog,
-                                            trig)
-        if not _meet(lo, hi, ia, xl, xh):
             return False
         if ib >= 0 and not _meet(lo, hi, ib, yl, yh):
             return False
