@@ -373,13 +373,14 @@ class _LazyUfunc:
         self._func = func
         self._nin = nin
         self._ufunc = None
+        self._loop = None  # the compiled NumPy inner loop (a Numba ``cfunc``), once built
         #: The scalar kernel as a Numba function, for compiled callers (and the loop).
         self.scalar = nb.njit(cache=True, error_model="numpy")(func)
         self.__name__ = func.__name__
         self.__doc__ = func.__doc__
 
     def _build(self):
-        loop = _kernel_loop(self._func, self.scalar, self._nin)
+        self._loop = loop = _kernel_loop(self._func, self.scalar, self._nin)
         self._ufunc = _internal.fromfunc(
             self._func.__name__, self._func.__doc__, [loop.address],
             [[_F8_NUM] * (self._nin + 1)], self._nin, 1, [None], [loop], _internal.PyUFunc_None)
