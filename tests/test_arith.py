@@ -150,3 +150,66 @@ def test_reflected_operators_with_numpy_scalars():
     assert np.float64(2) * x == Interval(2, 4)
     assert 1 - x == Interval(-1, 0)
     assert 2 / x == Interval(1, 2)
+
+
+def _ufunc_kernels():
+    from boundest.interval import algebraic, arith
+    from boundest.interval.rounding import _LazyUfunc
+
+    return [(f"{mod.__name__.rsplit('.', 1)[1]}.{name}", k) for mod in (arith, algebraic)
+            for name, k in sorted(vars(mod).items()) if isinstance(k, _LazyUfunc)]
+
+
+@pytest.mark.parametrize(("name", "kernel"), _ufunc_kernels(), ids=lambda v: v
+                         if isinstance(v, str) else "")
+def test_ufunc_loops_agree_on_contiguous_strided_and_broadcast_arguments(name, kernel):
+    # the compiled loop has a contiguous (SIMD) branch and a strided one: both must run the
+    # same kernel, element by element, and NumPy's conventions (scalars, out=) must hold
+    rng = np.random.default_rng(7)
+    special = np.array([0.0, -0.0, np.inf, -np.inf, np.nan, 2.0**-1074, 1e300, -1e-300])
+    cols = []
+    for j in range(kernel._nin):
+        a = rng.standard_normal(64) * 10.0 ** rng.integers(-300, 300, 64)
+        a[rng.integers(0, 64, 16)] = rng.choice(special, 16)
+        cols.append(np.sort(a) if j % 2 else a)  # a few ordered pairs, most not
+    ref = kernel(*cols)
+    assert ref.dtype == np.float64 and ref.shape == (64,)
+    wide = [np.repeat(c, 2) for c in cols]
+    assert np.array_equal(kernel(*[w[::2] for w in wide]), ref, equal_nan=True), name
+    out = np.full(128, -1.0)
+    assert kernel(*cols, out=out[1::2]) is not None
+    assert np.array_equal(out[1::2], ref, equal_nan=True) and np.all(out[::2] == -1.0)
+    k = 5
+    one = kernel(*[float(c[k]) for c in cols])
+    assert isinstance(one, np.float64)
+    assert np.array_equal(one, ref[k], equal_nan=True)
+    bcast = kernel(*[c if j == 1 else c[k] for j, c in enumerate(cols)])  # stride-0 arguments
+    single = [kernel(*[c[i] if j == 1 else c[k] for j, c in enumerate(cols)]) for i in range(64)]
+    assert np.array_equal(bcast, np.array(single), equal_nan=True), name
+    assert np.array_equal(kernel(*[c.reshape(8, 8) for c in cols]), ref.reshape(8, 8),
+                          equal_nan=True)
+
+
+_CACHE_SCRIPT = """
+import boundest as bd
+from boundest.interval import arith
+x = bd.Interval(1, 2) * bd.Interval(3, 4) + bd.Interval(0.5, 1.0)
+print(float(x.lo), float(x.hi), arith._add_lo._loop.cache_hits, arith._mul_hi._loop.cache_hits)
+"""
+
+
+def test_ufunc_loops_load_from_the_disk_cache_in_a_new_process(tmp_path):
+    # nb.vectorize rebuilt every ufunc's loop with LLVM in every process (50-75 ms each)
+    import os
+    import subprocess
+    import sys
+
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path))
+    runs = []
+    for _ in range(2):  # compiling, then loading what the first run cached
+        out = subprocess.run([sys.executable, "-c", _CACHE_SCRIPT], env=env,
+                             capture_output=True, text=True, timeout=900)
+        assert out.returncode == 0, out.stderr[-2000:]
+        runs.append(out.stdout.split())
+    assert runs[0] == ["3.5", "9.0", "0", "0"]
+    assert runs[1] == ["3.5", "9.0", "1", "1"]

@@ -16,13 +16,15 @@ fraction of the cost of ``np.nextafter``.
 from __future__ import annotations
 
 from collections.abc import Callable
+from types import FunctionType
 
 import numba as nb
 import numpy as np
 from llvmlite import ir
-from numba import types
+from numba import carray, types
 from numba.core import cgutils
 from numba.extending import intrinsic
+from numba.np.ufunc import _internal  # the ufunc constructor nb.vectorize uses
 
 __all__ = [
     "INF",
@@ -270,25 +272,121 @@ class _LazyGufunc:
             return ufunc(*args, **kwargs)
 
 
+# The ufunc loops. ``nb.vectorize(cache=True)`` caches a ufunc's element function on disk but
+# builds its loop again (LLVM) in every process, 50-75 ms a ufunc; a gufunc's loop is cached
+# but runs the branch-free kernels without SIMD. Instead, each kernel's loop is a ``cfunc``
+# with NumPy's inner-loop signature, cached on disk like any Numba function (a few ms to
+# load), registered as a NumPy ufunc the way ``nb.vectorize`` registers its own loops
+# (``numba.np.ufunc._internal.fromfunc``): broadcasting, ``out=``, casts and 0-d results are
+# NumPy's own. The loop has a contiguous branch, which LLVM vectorises with the kernel inlined,
+# and a strided one (broadcast scalars, views).
+_F8 = types.float64
+_LOOP_SIG = types.void(types.CPointer(types.voidptr), types.CPointer(types.intp),
+                       types.CPointer(types.intp), types.voidptr)
+_F8_NUM = np.dtype(np.float64).num
+
+
+@intrinsic
+def _load_f8(typingctx, ptr, offset):  # noqa: ARG001 - numba intrinsic signature
+    """The float64 at ``offset`` bytes past ``ptr``."""
+    def codegen(context, builder, signature, args):  # noqa: ARG001
+        p = builder.bitcast(builder.gep(args[0], [args[1]]), ir.DoubleType().as_pointer())
+        return builder.load(p)
+
+    return _F8(types.voidptr, types.intp), codegen
+
+
+@intrinsic
+def _store_f8(typingctx, ptr, offset, value):  # noqa: ARG001 - numba intrinsic signature
+    """Store the float64 ``value`` at ``offset`` bytes past ``ptr``."""
+    def codegen(context, builder, signature, args):  # noqa: ARG001
+        p = builder.bitcast(builder.gep(args[0], [args[1]]), ir.DoubleType().as_pointer())
+        builder.store(args[2], p)
+        return context.get_dummy_value()
+
+    return types.void(types.voidptr, types.intp, _F8), codegen
+
+
+# Loop templates, one per arity; ``_KERNEL`` is bound per kernel by ``_kernel_loop``.
+def _loop2(args, dims, steps, data):  # noqa: ARG001 - NumPy's inner-loop signature
+    n = dims[0]
+    p0, p1, po = args[0], args[1], args[2]
+    s0, s1, so = steps[0], steps[1], steps[2]
+    if s0 == 8 and s1 == 8 and so == 8:
+        a0, a1 = carray(p0, n, np.float64), carray(p1, n, np.float64)
+        o = carray(po, n, np.float64)
+        for i in range(n):
+            o[i] = _KERNEL(a0[i], a1[i])  # noqa: F821
+    else:
+        for i in range(n):
+            _store_f8(po, i * so, _KERNEL(_load_f8(p0, i * s0), _load_f8(p1, i * s1)))  # noqa: F821
+
+
+def _loop4(args, dims, steps, data):  # noqa: ARG001 - NumPy's inner-loop signature
+    n = dims[0]
+    p0, p1, p2, p3, po = args[0], args[1], args[2], args[3], args[4]
+    s0, s1, s2, s3, so = steps[0], steps[1], steps[2], steps[3], steps[4]
+    if s0 == 8 and s1 == 8 and s2 == 8 and s3 == 8 and so == 8:
+        a0, a1 = carray(p0, n, np.float64), carray(p1, n, np.float64)
+        a2, a3 = carray(p2, n, np.float64), carray(p3, n, np.float64)
+        o = carray(po, n, np.float64)
+        for i in range(n):
+            o[i] = _KERNEL(a0[i], a1[i], a2[i], a3[i])  # noqa: F821
+    else:
+        for i in range(n):
+            _store_f8(po, i * so, _KERNEL(_load_f8(p0, i * s0), _load_f8(p1, i * s1),  # noqa: F821
+                                          _load_f8(p2, i * s2), _load_f8(p3, i * s3)))
+
+
+_LOOPS = {2: _loop2, 4: _loop4}
+
+
+def _kernel_loop(func: Callable, nin: int) -> nb.core.ccallback.CFunc:
+    """The cached ``cfunc`` NumPy loop of one kernel.
+
+    A copy of the arity's template whose global ``_KERNEL`` is the kernel, inlined at Numba IR
+    level (one compilation per loop; an empty-cache run compiled a separate scalar kernel 10 %
+    slower), and whose name, file and first line are the kernel's: Numba keys its disk cache on
+    those (a closure would not do: its key hashes the pickled kernel, which differs in every
+    process).
+    """
+    template = _LOOPS[nin]
+    name = f"{func.__name__}_loop"
+    code = template.__code__.replace(co_name=name, co_qualname=f"{func.__qualname__}_loop",
+                                     co_filename=func.__code__.co_filename,
+                                     co_firstlineno=func.__code__.co_firstlineno)
+    kernel = nb.njit(inline="always", error_model="numpy")(func)  # not compiled on its own
+    loop = FunctionType(code, {**template.__globals__, "_KERNEL": kernel}, name)
+    loop.__qualname__ = f"{func.__qualname__}_loop"
+    loop.__module__ = func.__module__
+    return nb.cfunc(_LOOP_SIG, cache=True, error_model="numpy")(loop)
+
+
 class _LazyUfunc:
     """A NumPy ufunc ``f(a0, ..., a_{nin-1}) -> float64`` compiled by Numba on first call.
 
-    Used for the branch-free kernels of ``+ - * / sqr sqrt``, one ufunc per bound: Numba's
-    vectorised loops run them with SIMD, several times faster than a gufunc per element.
+    Used for the branch-free kernels of ``+ - * / sqr sqrt``, one ufunc per bound: the loop
+    runs them with SIMD on contiguous arrays, several times faster than a gufunc per element,
+    and is cached on disk (see ``_kernel_loop``).
     """
 
     def __init__(self, func: Callable, nin: int) -> None:
+        if nin not in _LOOPS:
+            raise ValueError(f"no ufunc loop for {nin} inputs (have {sorted(_LOOPS)})")
         self._func = func
         self._nin = nin
         self._ufunc = None
-        #: The scalar kernel as a Numba function, for compiled callers.
+        self._loop = None  # the compiled NumPy inner loop (a Numba ``cfunc``), once built
+        #: The scalar kernel as a Numba function, for compiled callers (and the loop).
         self.scalar = nb.njit(cache=True, error_model="numpy")(func)
         self.__name__ = func.__name__
         self.__doc__ = func.__doc__
 
     def _build(self):
-        sig = f"f8({','.join(['f8'] * self._nin)})"
-        self._ufunc = nb.vectorize([sig], cache=True)(self._func)
+        self._loop = loop = _kernel_loop(self._func, self._nin)
+        self._ufunc = _internal.fromfunc(
+            self._func.__name__, self._func.__doc__, [loop.address],
+            [[_F8_NUM] * (self._nin + 1)], self._nin, 1, [None], [loop], _internal.PyUFunc_None)
         return self._ufunc
 
     def __call__(self, *args, **kwargs):
