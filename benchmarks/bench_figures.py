@@ -5,8 +5,11 @@ Each run is a fresh process, ``python -c DRIVER``, where the driver calls
 ``boundest.cli.main(["run", NAME, "--out", TMP])`` as the console script does, after putting
 timers around:
 
-* ``Figure.savefig`` (``savefig_s``: drawing, layout engine included, and PNG encoding),
-* ``Figure.tight_layout`` (``tight_layout_s``, zero when the figures are laid out otherwise),
+* ``Figure.savefig`` (``savefig_s``: drawing, the layout engine when it runs there, PNG
+  encoding), ``Figure.tight_layout`` (``tight_layout_s``) and the layout engines' ``execute``
+  (``layout_engine_s``, wherever it runs, also inside the other two);
+* ``output_s``: the time spent in any of these, counted once where they nest: what laying out
+  and writing the figures costs;
 * the outermost imports of ``matplotlib``, ``mpl_toolkits`` and ``PIL`` modules
   (``matplotlib_import_s``).
 
@@ -42,16 +45,23 @@ SCENARIOS = ("satellite", "jaulin2001", "range-only", "drifting-clock", "auv", "
 
 DRIVER = r"""
 import importlib.abc, json, sys, time
-acc = {"savefig_s": 0.0, "tight_layout_s": 0.0, "matplotlib_import_s": 0.0, "figures": 0}
+acc = {"output_s": 0.0, "savefig_s": 0.0, "tight_layout_s": 0.0, "layout_engine_s": 0.0,
+       "matplotlib_import_s": 0.0, "figures": 0}
 depth = [0]
+out_depth = [0]
 
 def timed(fn, key, count=False):
     def wrapper(*a, **k):
         t = time.perf_counter()
+        out_depth[0] += 1
         try:
             return fn(*a, **k)
         finally:
-            acc[key] += time.perf_counter() - t
+            out_depth[0] -= 1
+            dt = time.perf_counter() - t
+            acc[key] += dt
+            if out_depth[0] == 0:
+                acc["output_s"] += dt
             acc["figures"] += count
     return wrapper
 
@@ -80,6 +90,9 @@ class Hook(importlib.abc.MetaPathFinder):
                 module.Figure.savefig = timed(module.Figure.savefig, "savefig_s", True)
                 module.Figure.tight_layout = timed(module.Figure.tight_layout,
                                                    "tight_layout_s")
+            if name == "matplotlib.layout_engine":
+                for cls in (module.ConstrainedLayoutEngine, module.TightLayoutEngine):
+                    cls.execute = timed(cls.execute, "layout_engine_s")
         spec.loader.exec_module = exec_module
         return spec
 
@@ -119,7 +132,7 @@ def one_run(name: str, tree: Path | None, tmp: Path, timeout: float) -> dict:
 
 
 def summarise(runs: list[dict]) -> dict:
-    keys = ("wall_s", "savefig_s", "tight_layout_s", "matplotlib_import_s")
+    keys = ("wall_s", "output_s", "savefig_s", "layout_engine_s", "matplotlib_import_s")
     return {f"{k}_median": round(statistics.median(r[k] for r in runs), 3)
             for k in keys if all(k in r for r in runs)}
 

@@ -51,28 +51,19 @@ def subplots(nrows: int = 1, ncols: int = 1, *, figsize: tuple[float, float] | N
     return fig, fig.subplots(nrows, ncols, **kwargs)
 
 
-#: zlib level of the PNG files: 1 writes them in about half the time of PIL's default 6, about
-#: 10 % larger
+#: zlib level of the PNG files: 1 saves 10-40 ms per figure against PIL's default 6 (measured on the
+#: figures of `boundest run`), for files about 10 % larger
 PNG_COMPRESSION = 1
 
 
 def save_figure(fig: Any, out: str | Path, name: str, dpi: int = 120) -> Path:
-    """Lay out ``fig`` once and write it to ``out/name.png`` (creating the folder), say so.
-
-    The layout is ``tight_layout``, or the figure's own layout engine (constrained layout) run
-    here once, at the resolution written, and then switched off: ``savefig`` would otherwise run
-    it in a draw pass of its own before drawing (the same pixels, one pass fewer). A pyplot
-    figure is closed.
-    """
+    """Lay out ``fig`` (unless it has its own layout engine), write it to ``out/name.png``
+    (creating the folder, zlib level :data:`PNG_COMPRESSION`), close it if pyplot made it, say
+    so."""
     folder = Path(out)
     folder.mkdir(parents=True, exist_ok=True)
-    engine = fig.get_layout_engine()
-    if engine is None:
+    if fig.get_layout_engine() is None:
         fig.tight_layout()
-    else:
-        fig.set_dpi(dpi)
-        engine.execute(fig)
-        fig.set_layout_engine("none")
     png = folder / f"{name}.png"
     fig.savefig(png, dpi=dpi, pil_kwargs={"compress_level": PNG_COMPRESSION})
     if fig.canvas.manager is not None:  # a pyplot figure
