@@ -91,3 +91,49 @@ def test_set_sequence_says_which_sets_are_empty():
     assert "NCSE: empty" in fig.axes[1].get_title()
     assert "RCSE, NCSE: empty" in fig.axes[2].get_title()
     plt.close(fig)
+
+
+def test_command_figures_are_written_without_pyplot(tmp_path):
+    from PIL import Image
+
+    from boundest.commands import save_figure, subplots
+
+    before = plt.get_fignums()
+    fig, ax = subplots(figsize=(4, 3))
+    plot_boxes(bd.Interval([0, 1], [1, 2]), bd.Interval([0, 0], [1, 1]), ax=ax, label="boxes")
+    ax.legend()
+    png = save_figure(fig, tmp_path / "new", "boxes", dpi=100)
+    assert plt.get_fignums() == before                  # never registered with pyplot
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == ["boxes"]
+    with Image.open(png) as im:
+        assert im.format == "PNG" and im.size == (400, 300)
+
+
+def test_save_figure_closes_a_pyplot_figure(tmp_path):
+    from boundest.commands import save_figure
+
+    fig, ax = plt.subplots(figsize=(3, 2))
+    ax.plot([0, 1], [0, 1])
+    save_figure(fig, tmp_path, "line")
+    assert fig.number not in plt.get_fignums()
+    assert (tmp_path / "line.png").stat().st_size > 1000
+
+
+SUBPLOTS_ALONE = """
+import sys
+from boundest.commands import save_figure, subplots
+fig, ax = subplots()
+ax.plot([0, 1], [0, 1])
+save_figure(fig, sys.argv[1], "line")
+print("pyplot" if "matplotlib.pyplot" in sys.modules else "no pyplot")
+"""
+
+
+def test_command_figures_do_not_import_pyplot(tmp_path):
+    import subprocess
+    import sys
+
+    out = subprocess.run([sys.executable, "-c", SUBPLOTS_ALONE, str(tmp_path)],
+                         capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.strip().endswith("no pyplot"), out.stdout

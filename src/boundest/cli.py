@@ -13,7 +13,7 @@ import importlib
 import sys
 
 from . import __version__
-from .commands import SCENARIOS, pyplot, save_figure, write_json
+from .commands import SCENARIOS, save_figure, subplots, write_json
 
 #: Measured empty-cache compile time of each command on the project's 2-core machine
 #: (``benchmarks/bench_startup.py``; the pool: 69 s, its observer one compiled kernel; the
@@ -26,8 +26,6 @@ COMPILE_ESTIMATE_S = {"satellite": 21, "jaulin2001": 11, "range-only": 23,
 def _demo(args: argparse.Namespace) -> int:
     import numpy as np
 
-    plt = pyplot()
-
     from .plot import plot_boxes
     from .scenarios import function_enclosure as fe
 
@@ -39,7 +37,7 @@ def _demo(args: argparse.Namespace) -> int:
     for r in result["enclosures"]:
         print(f"{r['pieces']:>6} [{r['range_lo']:>14.6f}, {r['range_hi']:>14.6f}] "
               f"{r['range_width']:>9.4f} {r['mean_box_height']:>16.5f}")
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), sharey=True)
+    fig, axes = subplots(1, 2, figsize=(11, 4.2), sharey=True)
     xs = np.linspace(*fe.DOMAIN, 2000)
     for ax, n in zip(axes, (16, 64), strict=True):
         enc = fe.enclose(n)

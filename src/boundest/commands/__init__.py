@@ -37,16 +37,37 @@ def pyplot() -> Any:
     return plt
 
 
+def subplots(nrows: int = 1, ncols: int = 1, *, figsize: tuple[float, float] | None = None,
+             layout: Any = None, **kwargs: Any) -> tuple[Any, Any]:
+    """``plt.subplots`` without pyplot: a ``Figure`` on an Agg canvas, and its axes.
+
+    The figure is not registered with pyplot (nothing to close); :func:`save_figure` writes it.
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=figsize, layout=layout)
+    FigureCanvasAgg(fig)
+    return fig, fig.subplots(nrows, ncols, **kwargs)
+
+
+#: zlib level of the PNG files: 1 saves 10-40 ms per figure against PIL's default 6 (measured on the
+#: figures of `boundest run`), for files about 10 % larger
+PNG_COMPRESSION = 1
+
+
 def save_figure(fig: Any, out: str | Path, name: str, dpi: int = 120) -> Path:
     """Lay out ``fig`` (unless it has its own layout engine), write it to ``out/name.png``
-    (creating the folder), close it, say so."""
+    (creating the folder, zlib level :data:`PNG_COMPRESSION`), close it if pyplot made it, say
+    so."""
     folder = Path(out)
     folder.mkdir(parents=True, exist_ok=True)
     if fig.get_layout_engine() is None:
         fig.tight_layout()
     png = folder / f"{name}.png"
-    fig.savefig(png, dpi=dpi)
-    pyplot().close(fig)
+    fig.savefig(png, dpi=dpi, pil_kwargs={"compress_level": PNG_COMPRESSION})
+    if fig.canvas.manager is not None:  # a pyplot figure
+        pyplot().close(fig)
     print(f"wrote {png}")
     return png
 

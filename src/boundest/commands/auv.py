@@ -7,7 +7,7 @@ import argparse
 import time
 from pathlib import Path
 
-from . import pyplot, save_figure, write_json
+from . import save_figure, subplots, write_json
 
 
 def _summary(res, data) -> None:
@@ -73,20 +73,19 @@ def run(args: argparse.Namespace) -> int:
         results.append(res)
     final = results[-1]
 
-    plt = pyplot()
     from ..plot.auv import plot_auv_depth, plot_auv_map, plot_auv_widths
 
-    fig, ax = plt.subplots(figsize=(10, 7.5))
+    fig, ax = subplots(figsize=(10, 7.5))
     plot_auv_map(data, results, ax=ax)
     ax.set_title(f"AUV survey ({final.mode}): position boxes, GPS fixes"
                  + (", mines and detections" if final.mode == "slam" else ""))
     save_figure(fig, args.out, f"auv_{final.mode}_map")
-    fig, ax = plt.subplots(figsize=(10, 4))
+    fig, ax = subplots(figsize=(10, 4))
     plot_auv_widths(data, results, ax=ax)
     ax.set_title("width of the position box against time"
                  + (": localization and SLAM" if final.mode == "slam" else ""))
     save_figure(fig, args.out, f"auv_{final.mode}_widths")
-    fig, ax = plt.subplots(figsize=(10, 3.5))
+    fig, ax = subplots(figsize=(10, 3.5))
     plot_auv_depth(data, final, ax=ax)
     ax.set_title("depth profile")
     save_figure(fig, args.out, f"auv_{final.mode}_depth")

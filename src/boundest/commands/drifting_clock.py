@@ -4,13 +4,11 @@ from __future__ import annotations
 
 import argparse
 
-from . import pyplot, save_figure, write_json
+from . import save_figure, subplots, write_json
 
 
 def run(args: argparse.Namespace) -> int:
     import numpy as np
-
-    plt = pyplot()
 
     from ..plot.scenarios_tube import plot_clock_distance, plot_clock_drift
     from ..scenarios import drifting_clock as dc
@@ -36,7 +34,7 @@ def run(args: argparse.Namespace) -> int:
                  "ephemeris [y](.) and the measurements (Rohou et al. 2018, Fig. 11)"),
                 ("clock_drift", plot_clock_drift,
                  "clock drift [h](.) and the times [t_i] (Rohou et al. 2018, Fig. 12)")):
-            fig, ax = plt.subplots(figsize=(9, 5.5))
+            fig, ax = subplots(figsize=(9, 5.5))
             fn(res, truth=truth, ax=ax)
             ax.set_title(title)
             save_figure(fig, args.out, name)

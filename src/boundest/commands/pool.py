@@ -16,7 +16,7 @@ import argparse
 import time
 from pathlib import Path
 
-from . import pyplot, save_figure, write_json
+from . import save_figure, subplots, write_json
 
 GUARANTEE = {
     True: ("the probability that one window of {m} pings holds at most {q} outliers; the "
@@ -126,7 +126,6 @@ def run(args: argparse.Namespace) -> int:
         f"# rejected: pings of the window inconsistent with X_k\n{table}\n")
     print(f"wrote {out / 'pool_table.txt'}")
 
-    plt = pyplot()
     from ..plot.pool import (
         ping_consistency,
         plot_pool_emission,
@@ -138,7 +137,7 @@ def run(args: argparse.Namespace) -> int:
 
     consistent = ping_consistency(data, res)
     snaps = np.unique(np.rint(np.linspace(0, data.n - 1, 6)).astype(int))
-    fig, axes = plt.subplots(2, 3, figsize=(15, 7.4), layout="constrained")
+    fig, axes = subplots(2, 3, figsize=(15, 7.4), layout="constrained")
     for i, (ax, k) in enumerate(zip(axes.flat, snaps, strict=False)):
         last = i == len(snaps) - 1
         plot_pool_snapshot(data, res, int(k), consistent, ax=ax, pings=last)
@@ -155,13 +154,13 @@ def run(args: argparse.Namespace) -> int:
                  "empties (X_j, ping j)", fontsize=10)
     save_figure(fig, args.out, "pool_snapshots")
 
-    fig, ax = plt.subplots(figsize=(7, 7))
+    fig, ax = subplots(figsize=(7, 7))
     plot_pool_emission(data, consistent, ax=ax)
     ax.set_title(f"emission diagram: the last {min(80, data.n)} pings (one revolution) "
                  f"up to t = {data.t[-1]:.2f} s, robot frame", fontsize=10)
     save_figure(fig, args.out, "pool_emission")
 
-    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(10, 8.5),
+    fig, (ax1, ax2) = subplots(2, 1, figsize=(10, 8.5),
                                    gridspec_kw={"height_ratios": [1.6, 1]})
     plot_pool_trajectory(data, res, ax=ax1)
     ax1.set_title(f"trajectory envelope (q = {args.q}, m = {args.m})")

@@ -10,7 +10,7 @@ from collections.abc import Iterator
 from concurrent.futures import Executor, ProcessPoolExecutor
 from pathlib import Path
 
-from . import pyplot, save_figure, write_json
+from . import save_figure, subplots, write_json
 
 
 @contextlib.contextmanager
@@ -103,10 +103,9 @@ def run_monte_carlo(args: argparse.Namespace) -> int:
         f"# frequency of x_k in X_k, its 95 % Wilson interval, the claimed one-window P\n"
         f"{table}\n")
     print(f"wrote {out / 'pool_monte_carlo.txt'}")
-    plt = pyplot()
     from ..plot.monte_carlo import plot_containment
 
-    fig, ax = plt.subplots(figsize=(9, 5))
+    fig, ax = subplots(figsize=(9, 5))
     plot_containment(mc, ax=ax)
     ax.set_title(f"pool robot: does X_k contain the truth? {mc.missions} simulated missions, "
                  f"q = {mc.q}, m = {mc.m}", fontsize=10)

@@ -4,13 +4,11 @@ from __future__ import annotations
 
 import argparse
 
-from . import pyplot, save_figure, write_json
+from . import save_figure, subplots, write_json
 
 
 def run(args: argparse.Namespace) -> int:
     import numpy as np
-
-    plt = pyplot()
 
     from ..plot.scenarios_tube import plot_range_only_diagonal, plot_range_only_map
     from ..scenarios import range_only as ro
@@ -44,12 +42,12 @@ def run(args: argparse.Namespace) -> int:
                   f"(data [{meas.t.lo[i]:.2f}, {meas.t.hi[i]:.2f}]), "
                   f"[z_{i + 1}] = [{res.z.lo[i]:.3f}, {res.z.hi[i]:.3f}]")
         truth = ro.RobotTruth() if args.data is None else None
-        fig, ax = plt.subplots(figsize=(9, 4))
+        fig, ax = subplots(figsize=(9, 4))
         plot_range_only_diagonal(res, ax=ax)
         ax.set_title(f"position-box diagonal per iteration (Rohou et al. 2018, Fig. 8), "
                      f"dt = {args.dt:g}")
         save_figure(fig, args.out, "range_only_diagonal")
-        fig, ax = plt.subplots(figsize=(9, 7))
+        fig, ax = subplots(figsize=(9, 7))
         plot_range_only_map(res, truth=truth, ax=ax)
         ax.set_title("[x1](.) x [x2](.) among the beacons (Rohou et al. 2018, Fig. 9)")
         save_figure(fig, args.out, "range_only_map")

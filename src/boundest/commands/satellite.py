@@ -4,13 +4,11 @@ from __future__ import annotations
 
 import argparse
 
-from . import pyplot, save_figure, write_json
+from . import save_figure, subplots, write_json
 
 
 def run(args: argparse.Namespace) -> int:
     import numpy as np
-
-    plt = pyplot()
 
     from ..interval import Interval
     from ..plot import plot_boxes
@@ -46,7 +44,7 @@ def run(args: argparse.Namespace) -> int:
         w = res.x_hi - res.x_lo
         print("  mean width over k: " + ", ".join(f"x{i + 1} {np.mean(w[:, i]):.3f}"
                                                   for i in range(4)))
-        fig, ax = plt.subplots(figsize=(6.5, 6))
+        fig, ax = subplots(figsize=(6.5, 6))
         plot_boxes(Interval._new(res.x_lo[:, 0], res.x_hi[:, 0]),
                    Interval._new(res.x_lo[:, 1], res.x_hi[:, 1]), ax=ax,
                    label="box [x1](k) x [x2](k), one per k")

@@ -14,7 +14,7 @@ import statistics
 from pathlib import Path
 from typing import Any
 
-from . import pyplot, save_figure, write_json
+from . import save_figure, subplots, write_json
 
 #: Subpavings are computed for models of at most this many variables (SIVIA bisects every
 #: dimension; beyond a few the number of boxes explodes).
@@ -172,11 +172,10 @@ def run(args: argparse.Namespace) -> int:
         data["paving"] = {"eps": eps, "variables": list(res.domains),
                           "boxes": paving.boxes, "stopped": st.get("stopped")}
         if paving.dim >= 2 and not empty:
-            plt = pyplot()
             from ..plot.paving import plot_paving
 
             names = list(res.domains)
-            fig, ax = plt.subplots(figsize=(6, 5.5))
+            fig, ax = subplots(figsize=(6, 5.5))
             plot_paving(paving, ax=ax, dims=(0, 1))
             ax.set_xlabel(names[0])
             ax.set_ylabel(names[1])
