@@ -394,7 +394,7 @@ def bc_closures(out, a, b, aptr, aadj, stop, cand, max_nodes):
     """The sub-networks on which box consistency narrows each candidate slot.
 
     For slot ``x = cand[j]``: the nodes reachable from ``x`` forward (from an argument to the
-    node's output), through slots that are not ``stop`` (the named variables: a constraint's
+    node's output), through slots that are not ``stop`` (the variables narrowed: a constraint's
     expression ends at them), breadth first, at most ``max_nodes`` of them, in tape order.
     ``aptr``/``aadj`` list, for each slot, the nodes that read it as an argument (CSR). A
     candidate is kept only when ``x`` occurs several times in its sub-network: some node reads

@@ -247,11 +247,13 @@ def arg_users(tape: Tape) -> tuple[np.ndarray, np.ndarray]:
 def bc_candidates(tape: Tape, slots: np.ndarray, max_nodes: int
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The slots among ``slots`` that occur several times in their constraints, with their
-    sub-networks (``engine.bc_closures``): ``(cand, cptr, cnodes)``."""
+    sub-networks (``engine.bc_closures``, which stop at ``slots``: a variable's constraints
+    reach up to the other variables narrowed, through any other named variable, such as a
+    measured output that names a sub-expression): ``(cand, cptr, cnodes)``."""
     aptr, aadj = arg_users(tape)
-    stop = np.zeros(tape.n_slots, dtype=np.bool_)
-    stop[list(tape.slot_of.values())] = True
     slots = np.asarray(slots, dtype=np.int64)
+    stop = np.zeros(tape.n_slots, dtype=np.bool_)
+    stop[slots] = True
     keep, cptr, cnodes = bc_closures(tape.out, tape.a, tape.b, aptr, aadj, stop, slots,
                                      int(max_nodes))
     return slots[keep], cptr, cnodes
@@ -278,7 +280,7 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
     ``mode="bc"`` adds box consistency (BC3, Benhamou et al. 1999) after hull consistency:
     each variable of ``targets`` that occurs several times in its constraints has its bounds
     narrowed to the outermost slices whose image by the natural interval extension of those
-    constraints (the sub-network of nodes it reaches, up to the named variables) meets the
+    constraints (the sub-network of nodes it reaches, up to the other ``targets``) meets the
     domains; what it narrows is propagated by hull consistency, round after round while it
     pays (``engine.bc_kernel``). Each search is local and bounded (``boxcons``), so its cost
     per variable does not grow with the CSP. ``mode="bc+3b"`` runs box consistency, then
