@@ -60,6 +60,8 @@ def main() -> None:
     ap.add_argument("--samples", type=int, default=60000)
     ap.add_argument("--lp-stride", type=int, default=600)
     ap.add_argument("--problems", default="localization,slam")
+    ap.add_argument("--no-warmup", action="store_true",
+                    help="time the first run too (the kernels load outside the timing)")
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--only", help="only the modes whose label matches this regex")
     ap.add_argument("--update", action="store_true",
@@ -92,8 +94,8 @@ def main() -> None:
             reps = 1 if mode == "lp" else args.repeat
             if mode == "lp":  # SciPy's import and HiGHS' first use, on a short prefix
                 propagate(discrete_tape(_prefix(data, 50), slam), mode="lp", progress=False)
-            else:
-                once()  # warm-up (the kernels)
+            elif not args.no_warmup:
+                once()  # a warm-up (propagate loads its kernels outside its timing anyway)
             runs = [once() for _ in range(reps)]
             r = runs[-1]
             w = r.slots.hi - r.slots.lo
@@ -123,6 +125,7 @@ def main() -> None:
                       key=lambda r: (r["problem"], order.index(r["mode"])))
         parts = old.get("parts", [])
     parts.append({"only": args.only, "problems": args.problems, "repeat": args.repeat,
+                  "warmup": not args.no_warmup,
                   "wall_s": time.perf_counter() - t_start})
     import numba
 
