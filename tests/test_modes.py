@@ -51,6 +51,7 @@ def _check(model, n, pts, res, hc):
         assert hc[name].lo <= dom.lo and dom.hi <= hc[name].hi, (name, hc[name], dom)
 
 
+@pytest.mark.slow  # about 100 s with an empty kernel cache (a compile per op family), 5 s warm
 @settings(max_examples=120, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(csps(), st.sampled_from(SETTINGS))
 def test_solutions_survive_box_consistency_in_the_engine(csp, mode_kw):
