@@ -93,7 +93,7 @@ class BoxConsistency:
         refuted.
     max_nodes : int
         Nodes of a variable's sub-network at most (the constraints it occurs in, up to the
-        named variables; breadth first from the variable).
+        other variables narrowed, ``targets``; breadth first from the variable).
     rounds : int
         Rounds over the candidates at most.
     reach : int
