@@ -126,7 +126,8 @@ def test_model_domains_and_arguments():
     out = CtcBox(m)(Interval([-5.0], [5.0]))
     assert 0.5 <= out.lo[0] <= 1.0 <= out.hi[0] < 1.01
     assert occurrences(x * (x - 1) + z) == {"x": 2, "z": 1}
-    assert CtcBox([x + z == 1], ["x", "z"]).pairs == []  # nothing occurs twice
+    assert CtcBox([x + z == 1], ["x", "z"]).candidates == []  # nothing occurs twice
+    assert CtcBox([x * (x - 1) == z], ["x", "z"]).candidates == ["x"]
     with pytest.raises(ValueError):
         CtcBox([x * x == 1], ["y"])
     with pytest.raises(ValueError):

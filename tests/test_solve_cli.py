@@ -92,3 +92,26 @@ def test_paving_refuses_large_or_unbounded_models(tmp_path, capsys):
     f.write_text(decl + ";\nConstraints\nv0 + v1 = 1;\n")
     assert main(["solve", str(f), "--paving", "0.1"]) == 2
     assert "at most 12 variables" in capsys.readouterr().err
+
+
+def test_mode_option_runs_each_mode_and_reports_its_cost(tmp_path, capsys):
+    from boundest.commands.solve import PROPAGATION_MODES
+    from boundest.csp import MODES
+
+    assert PROPAGATION_MODES == MODES
+    f = tmp_path / "m.txt"
+    f.write_text("Variables\nx in [-10, 10];\nConstraints\nx * x - x = 0;\n")
+    widths = {}
+    for mode in ("hc4", "bc", "bc+3b"):
+        out = tmp_path / f"{mode}.json"
+        assert main(["solve", str(f), "--mode", mode, "--json", str(out)]) == 0
+        first = capsys.readouterr().out.splitlines()[0]
+        assert f"mode {mode}:" in first
+        assert ("box consistency" in first) == (mode != "hc4")
+        d = json.loads(out.read_text())
+        assert d["mode"] == mode
+        x = d["domains"]["x"]
+        widths[mode] = x[1] - x[0]
+    assert widths["hc4"] == 20.0 and widths["bc"] < 1.1 and widths["bc+3b"] <= widths["bc"]
+    with pytest.raises(SystemExit):
+        main(["solve", str(f), "--mode", "bc3"])

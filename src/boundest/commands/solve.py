@@ -16,6 +16,10 @@ from typing import Any
 
 from . import save_figure, subplots, write_json
 
+#: ``boundest.csp.MODES``, spelt out here so that ``boundest --help`` does not import Numba
+#: (``tests/test_solve_cli.py`` checks that the two agree)
+PROPAGATION_MODES = ("hc4", "bc", "3b", "bc+3b", "lp")
+
 #: Subpavings are computed for models of at most this many variables (SIVIA bisects every
 #: dimension; beyond a few the number of boxes explodes).
 MAX_PAVING_VARIABLES = 12
@@ -128,6 +132,23 @@ def pave(model: Any, domains: dict[str, Any], eps: float, max_boxes: int) -> Any
     return sivia(Interval._new(lo, hi), ctc_out=ctc, eps=eps, max_boxes=max_boxes)
 
 
+def _phases(res: Any) -> str:
+    """The cost of the phases after hull consistency, for the summary line."""
+    parts = []
+    if res.boxcons:
+        b = res.boxcons
+        parts.append(f"box consistency {b['time_s']:.3f} s ({b['candidates']} variables, "
+                     f"{b['narrowed']} narrowed)")
+    if res.shaving:
+        s = res.shaving
+        parts.append(f"shaving {s['time_s']:.3f} s ({s['probes']} probes, {s['refuted']} "
+                     "slices refuted)")
+    if res.linear:
+        q = res.linear
+        parts.append(f"LPs {q['lp_time_s']:.3f} s ({q['rounds']} rounds)")
+    return "; of which " + ", ".join(parts) if parts else ""
+
+
 def run(args: argparse.Namespace) -> int:
     """``boundest solve``: propagate, print the summary (every domain with ``--all``), pave."""
     from ..csp import propagate
@@ -139,10 +160,11 @@ def run(args: argparse.Namespace) -> int:
         if not args.paving > 0.0:
             raise ValueError(f"--paving must be a positive precision, got {args.paving}")
         eps = args.paving
-    res = propagate(model, rel_eps=args.rel_eps)
+    res = propagate(model, rel_eps=args.rel_eps, mode=args.mode)
     status = "consistent" if res.consistent else "INCONSISTENT (no solution)"
     print(f"{args.file}: {len(model.domains)} variables, {len(model.constraints)} constraints: "
-          f"{status}; {res.evaluations} node revisions in {res.time_s:.3f} s")
+          f"{status}; mode {res.mode}: {res.evaluations} node revisions in {res.time_s:.3f} s"
+          + _phases(res))
     if args.all:
         width = max((len(n) for n in res.domains), default=0)
         for name, dom in res.domains.items():
@@ -154,6 +176,7 @@ def run(args: argparse.Namespace) -> int:
             print(line)
         print("(--all prints every domain; --json writes them)")
     data: dict[str, Any] = {"file": str(args.file), "consistent": res.consistent,
+                            "mode": res.mode,
                             "evaluations": res.evaluations, "time_s": res.time_s,
                             "domains": res.domains}
     paving = None
@@ -198,6 +221,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--rel-eps", type=float, default=1e-3,
                    help="propagation stops when no domain shrinks by more than this fraction "
                         "of its width (default 1e-3)")
+    p.add_argument("--mode", choices=PROPAGATION_MODES, default="hc4",
+                   help="hull consistency alone (hc4, default), then box consistency (bc), "
+                        "3B shaving (3b), both (bc+3b) or LP contraction (lp, needs the lp "
+                        "extra); see boundest.csp.propagate")
     p.add_argument("--all", action="store_true",
                    help="print every variable's domain instead of the summary")
     p.add_argument("--paving", type=float, metavar="EPS",

@@ -22,7 +22,8 @@ import numpy as np
 from ..ctc.revise import family_flags
 from ..ctc.revise import revise as _revise
 
-__all__ = ["DONE", "EMPTY", "RUNNING", "SHAVE_STATS", "family_flags", "propagate_kernel",
+__all__ = ["BC_STATS", "DONE", "EMPTY", "RUNNING", "SHAVE_STATS", "bc_boxes", "bc_closures",
+           "bc_kernel", "family_flags", "propagate_kernel", "repropagate_kernel",
            "shave_kernel"]
 
 DONE, RUNNING, EMPTY = 0, 1, 2
@@ -380,3 +381,339 @@ def shave_kernel(op, out, a, b, param, lo, hi, ptr, adj, cand, rel_eps, probe_ep
                     active[q] = True
     stats[4] = total
     return DONE
+
+
+# --- box consistency (BC3) on the tape ----------------------------------------------------
+
+#: The counters ``bc_kernel`` writes into its ``stats`` argument, in this order.
+BC_STATS = ("rounds", "searches", "narrowed", "bc_evaluations", "evaluations")
+
+
+@nb.njit(cache=True, error_model="numpy")
+def bc_closures(out, a, b, aptr, aadj, stop, cand, max_nodes):
+    """The sub-networks on which box consistency narrows each candidate slot.
+
+    For slot ``x = cand[j]``: the nodes reachable from ``x`` forward (from an argument to the
+    node's output), through slots that are not ``stop`` (the variables narrowed: a constraint's
+    expression ends at them), breadth first, at most ``max_nodes`` of them, in tape order.
+    ``aptr``/``aadj`` list, for each slot, the nodes that read it as an argument (CSR). A
+    candidate is kept only when ``x`` occurs several times in its sub-network: some node reads
+    two slots (or one slot twice) that depend on ``x``; where it occurs once, hull consistency
+    is already as tight. Returns ``(keep, cptr, cnodes)``: the kept candidates' positions in
+    ``cand`` and the CSR lists of their nodes.
+    """
+    n_nodes, n_slots, m = out.size, stop.size, cand.size
+    seen_node = np.full(n_nodes, -1, dtype=np.int64)
+    seen_slot = np.full(n_slots, -1, dtype=np.int64)
+    queue = np.empty(max_nodes + 1, dtype=np.int64)
+    found = np.empty(max_nodes, dtype=np.int64)
+    keep = np.empty(m, dtype=np.int64)
+    cptr = np.zeros(m + 1, dtype=np.int64)
+    cnodes = np.empty(m * max_nodes, dtype=np.int64)
+    nk, nn = 0, 0
+    for j in range(m):
+        x = cand[j]
+        seen_slot[x] = j
+        queue[0] = x
+        qlen, head, nf = 1, 0, 0
+        while head < qlen and nf < max_nodes:
+            s = queue[head]
+            head += 1
+            for k in range(aptr[s], aptr[s + 1]):
+                i = aadj[k]
+                if seen_node[i] == j:
+                    continue
+                if nf >= max_nodes:
+                    break
+                seen_node[i] = j
+                found[nf] = i
+                nf += 1
+                o = out[i]
+                if seen_slot[o] != j:
+                    seen_slot[o] = j
+                    if not stop[o]:
+                        queue[qlen] = o
+                        qlen += 1
+        multi = False
+        for q in range(nf):
+            i = found[q]
+            c = 1 if seen_slot[a[i]] == j else 0
+            if b[i] >= 0 and seen_slot[b[i]] == j:
+                c += 1
+            if c >= 2:
+                multi = True
+                break
+        if multi:
+            keep[nk] = j
+            srt = np.sort(found[:nf])
+            cnodes[nn:nn + nf] = srt
+            nn += nf
+            nk += 1
+            cptr[nk] = nn
+    return keep[:nk], cptr[:nk + 1], cnodes[:nn]
+
+
+@nb.njit(cache=True, inline="always", error_model="numpy")
+def _point(lo, hi, t):
+    """``lo + t (hi - lo)`` for dyadic ``t`` in [0, 1]: exactly ``lo`` at 0 and ``hi`` at 1
+    and non-decreasing in ``t`` (rounding is monotone), so adjacent slices of the bisection
+    tree share their endpoints exactly and cover the domain; no overflow when ``hi - lo``
+    does."""
+    if t == 0.0:
+        return lo
+    if t == 1.0:
+        return hi
+    w = hi - lo
+    p = lo + t * w if np.isfinite(w) else 2.0 * (0.5 * lo + t * (0.5 * hi - 0.5 * lo))
+    return min(max(p, lo), hi)
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _image_meets(x, sl, sh, k0, k1, cnodes, op, out, a, b, param, lo, hi, slo, shi, stamp,
+                 ev, buf, piecewise, pown, explog, trig):
+    """Whether the slice ``[sl, sh]`` of slot ``x`` may hold a solution: the nodes
+    ``cnodes[k0:k1]`` are evaluated forward with ``x`` in the slice and every other input at
+    its domain, each image intersected with its output's domain (the natural interval
+    extension, outward rounded by the revisions' operators). False when one image is empty:
+    no solution has ``x`` in the slice. ``slo/shi`` hold the images, valid where ``stamp ==
+    ev``."""
+    stamp[x] = ev
+    slo[x], shi[x] = sl, sh
+    for k in range(k0, k1):
+        i = cnodes[k]
+        o, ia, ib = out[i], a[i], b[i]
+        xl, xh = (slo[ia], shi[ia]) if stamp[ia] == ev else (lo[ia], hi[ia])
+        yl, yh = 0.0, 0.0
+        if ib >= 0:
+            yl, yh = (slo[ib], shi[ib]) if stamp[ib] == ev else (lo[ib], hi[ib])
+        zl, zh = (slo[o], shi[o]) if stamp[o] == ev else (lo[o], hi[o])
+        zl, zh, xl, xh, yl, yh = _revise(op[i], zl, zh, xl, xh, yl, yh, param[i], buf,
+                                           piecewise, pown, explog, trig)
+        if not zl <= zh:  # NaN (empty) or crossed bounds
+            return False
+        stamp[o] = ev
+        slo[o], shi[o] = zl, zh
+    return True
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _bc3_bound(x, side, k0, k1, cnodes, op, out, a, b, param, lo, hi, slo, shi, stamp, cnt,
+               eps, max_depth, max_steps, buf, piecewise, pown, explog, trig):
+    """BC3 (Benhamou, McAllester, Van Hentenryck 1999) on one bound of slot ``x``: the
+    depth-first leftmost (``side`` 0) or rightmost (1) search, over the dyadic bisection tree
+    of ``x``'s domain, of a slice whose image meets the domains (``_image_meets``). A slice
+    that meets them is the answer when it is at most ``eps`` wide, ``max_depth`` bisections
+    deep or unbounded, else it is bisected; a refuted slice gives way to the next one in
+    depth-first order. After ``max_steps`` evaluations the search keeps the end of its current
+    slice (every slice before it was refuted). Returns ``(bound, empty)``; ``cnt[0]`` (the
+    evaluation stamp) and ``cnt[1]`` (node evaluations) are advanced."""
+    L, U = lo[x], hi[x]
+    finite = np.isfinite(L) and np.isfinite(U)
+    d, k = 0, 0
+    for _ in range(max_steps):
+        scale = 2.0 ** (-d)  # exact: d <= 52
+        t0, t1 = k * scale, (k + 1) * scale
+        if side == 1:
+            t0, t1 = 1.0 - t1, 1.0 - t0
+        sl, sh = _point(L, U, t0), _point(L, U, t1)
+        cnt[0] += 1
+        cnt[1] += k1 - k0
+        if _image_meets(x, sl, sh, k0, k1, cnodes, op, out, a, b, param, lo, hi, slo, shi,
+                        stamp, cnt[0], buf, piecewise, pown, explog, trig):
+            if sh - sl <= eps or d >= max_depth or not finite:
+                return (sl if side == 0 else sh), False
+            d += 1
+            k *= 2
+        else:
+            while (k & 1) == 1 and d > 0:
+                k >>= 1
+                d -= 1
+            if d == 0:  # the whole domain refuted
+                return np.nan, True
+            k += 1
+    scale = 2.0 ** (-d)
+    return _point(L, U, k * scale if side == 0 else 1.0 - k * scale), False
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _bc3(x, k0, k1, cnodes, op, out, a, b, param, lo, hi, slo, shi, stamp, cnt, eps,
+         max_depth, max_steps, buf, piecewise, pown, explog, trig):
+    """Both bounds of slot ``x`` by ``_bc3_bound``, the lower one first (the upper search runs
+    on what is left). Returns False when ``x``'s whole domain was refuted (the slot is then
+    empty)."""
+    for side in range(2):
+        bound, empty = _bc3_bound(x, side, k0, k1, cnodes, op, out, a, b, param, lo, hi, slo,
+                                  shi, stamp, cnt, eps, max_depth, max_steps, buf, piecewise,
+                                  pown, explog, trig)
+        if empty:
+            lo[x] = np.nan
+            hi[x] = np.nan
+            return False
+        if side == 0:
+            lo[x] = max(lo[x], bound)
+        else:
+            hi[x] = min(hi[x], bound)
+    return True
+
+
+@nb.njit(cache=True, error_model="numpy")
+def bc_boxes(op, out, a, b, param, lo0, hi0, var_slot, blo, bhi, cand, cptr, cnodes, eps,
+             max_depth, max_steps, piecewise=None, pown=None, explog=None, trig=None):
+    """One pass of box consistency over the candidates, for each box of a batch (in place).
+
+    Box ``r`` gives the domains ``[blo[r, v], bhi[r, v]]`` of the variables, which live in the
+    slots ``var_slot[v]`` (two variables merged into one slot are intersected); every other
+    slot starts at ``[lo0, hi0]``. Candidate ``j`` (slot ``cand[j]``, nodes
+    ``cnodes[cptr[j]:cptr[j + 1]]``, from ``bc_closures``) is narrowed by ``_bc3``, each
+    narrowing seen by the next. A box with an empty domain becomes all NaN. Returns the node
+    evaluations spent."""
+    m, nv = blo.shape
+    n_slots = lo0.size
+    slo, shi = np.empty(n_slots), np.empty(n_slots)
+    stamp = np.full(n_slots, -1, dtype=np.int64)
+    cnt = np.zeros(2, dtype=np.int64)
+    buf = np.empty(4)
+    lo, hi = np.empty(n_slots), np.empty(n_slots)
+    for r in range(m):
+        lo[:] = lo0
+        hi[:] = hi0
+        ok = True
+        for v in range(nv):
+            s = var_slot[v]
+            nl, nh = blo[r, v], bhi[r, v]
+            if not nl <= nh:
+                ok = False
+                break
+            lo[s] = max(lo[s], nl)
+            hi[s] = min(hi[s], nh)
+            if not lo[s] <= hi[s]:
+                ok = False
+                break
+        j = 0
+        while ok and j < cand.size:
+            ok = _bc3(cand[j], cptr[j], cptr[j + 1], cnodes, op, out, a, b, param, lo, hi, slo,
+                      shi, stamp, cnt, eps, max_depth, max_steps, buf, piecewise, pown, explog,
+                      trig)
+            j += 1
+        for v in range(nv):
+            s = var_slot[v]
+            blo[r, v] = lo[s] if ok else np.nan
+            bhi[r, v] = hi[s] if ok else np.nan
+    return cnt[1]
+
+
+@nb.njit(cache=True, error_model="numpy")
+def bc_kernel(op, out, a, b, param, lo, hi, ptr, adj, cand, cptr, cnodes, rel_eps, eps,
+              max_depth, max_steps, max_rounds, reach, min_gain, window, stats, piecewise=None,
+              pown=None, explog=None, trig=None):
+    """Hull consistency with box consistency (BC3) on top, in place on ``lo``/``hi``.
+
+    First the whole tape is propagated to its fixed point. Then, round by round, each
+    candidate still active (in ``cand`` order, then in reverse order on the next round; the
+    candidates and their sub-networks from ``bc_closures``) has both bounds narrowed by BC3
+    (``_bc3``: slices at most ``eps`` wide or ``max_depth`` bisections deep, ``max_steps``
+    evaluations per bound); when that shrinks its domain by more than ``rel_eps`` of its width,
+    the nodes using it become dirty and the dirty windows are propagated to the fixed point
+    again (only those the change reaches). A candidate stays active in the next round only when
+    it or one within ``reach`` positions of it lost more than ``min_gain`` of its width in this
+    round; the rounds stop when none did, or after ``max_rounds``. Each BC3 search costs at most
+    ``2 max_steps`` evaluations of a sub-network of bounded size, so the cost per candidate
+    does not grow with the tape. ``stats`` receives the counters named in :data:`BC_STATS`.
+    Returns DONE, or EMPTY when the network was proven to have no solution.
+    """
+    n = op.size
+    nw = (n + window - 1) // window
+    m = cand.size
+    dirty = np.ones(n, dtype=np.bool_)
+    pending = np.zeros(nw, dtype=np.int64)
+    for i in range(n):
+        pending[i // window] += 1
+    span = np.array([0, nw - 1], dtype=np.int64)
+    cnt = np.array([n, 0], dtype=np.int64)
+    buf = np.empty(4)
+    changed = np.empty(3, dtype=np.int64)
+    tpos = np.zeros(1, dtype=np.int64)
+    big = np.iinfo(np.int64).max
+    n_slots = lo.size
+    slo, shi = np.empty(n_slots), np.empty(n_slots)
+    stamp = np.full(n_slots, -1, dtype=np.int64)
+    bcnt = np.zeros(2, dtype=np.int64)
+    for k in range(stats.size):
+        stats[k] = 0
+    if not _drain(op, out, a, b, param, lo, hi, ptr, adj, dirty, pending, span, window, rel_eps,
+                  buf, changed, cnt, big, tpos[:0], buf[:0], tpos, piecewise, pown, explog, trig):
+        stats[4] = cnt[1]
+        return EMPTY
+    total = cnt[1]
+    _forget(dirty, pending, span, window, cnt)
+    active = np.ones(m, dtype=np.bool_)
+    gained = np.zeros(m, dtype=np.bool_)
+    for rnd in range(max_rounds):
+        stats[0] += 1
+        for jj in range(m):
+            j = jj if rnd % 2 == 0 else m - 1 - jj
+            gained[j] = False
+            if not active[j]:
+                continue
+            x = cand[j]
+            l0, h0 = lo[x], hi[x]
+            stats[1] += 1
+            ok = _bc3(x, cptr[j], cptr[j + 1], cnodes, op, out, a, b, param, lo, hi, slo, shi,
+                      stamp, bcnt, eps, max_depth, max_steps, buf, piecewise, pown, explog, trig)
+            if not ok:
+                stats[3] = bcnt[1]
+                stats[4] = total
+                return EMPTY
+            if _significant(l0, h0, lo[x], hi[x], rel_eps):
+                stats[2] += 1
+                _touch(x, ptr, adj, dirty, pending, span, window, cnt)
+                cnt[1] = 0
+                ok = _drain(op, out, a, b, param, lo, hi, ptr, adj, dirty, pending, span,
+                            window, rel_eps, buf, changed, cnt, big, tpos[:0], buf[:0], tpos,
+                            piecewise, pown, explog, trig)
+                total += cnt[1]
+                if not ok:
+                    stats[3] = bcnt[1]
+                    stats[4] = total
+                    return EMPTY
+                _forget(dirty, pending, span, window, cnt)
+            w0, w1 = h0 - l0, hi[x] - lo[x]
+            gained[j] = w0 > 0 and w1 < w0 and (w0 == np.inf or w0 - w1 > min_gain * w0)
+        anyg = False
+        for j in range(m):
+            active[j] = False
+            anyg |= gained[j]
+        if not anyg:
+            break
+        for j in range(m):
+            if gained[j]:
+                for q in range(max(0, j - reach), min(m, j + reach + 1)):
+                    active[q] = True
+    stats[3] = bcnt[1]
+    stats[4] = total
+    return DONE
+
+
+@nb.njit(cache=True, error_model="numpy")
+def repropagate_kernel(op, out, a, b, param, lo, hi, ptr, adj, slots, rel_eps, window, stats,
+                       piecewise=None, pown=None, explog=None, trig=None):
+    """Propagate the change of the domains of ``slots`` (made outside the engine, e.g. by an
+    LP) from a fixed point: only the nodes using them become dirty, and only the windows the
+    change reaches are revised, to the fixed point at ``rel_eps``. ``stats[0]`` receives the
+    node revisions. Returns DONE or EMPTY."""
+    n = op.size
+    nw = (n + window - 1) // window
+    dirty = np.zeros(n, dtype=np.bool_)
+    pending = np.zeros(nw, dtype=np.int64)
+    span = np.array([nw, -1], dtype=np.int64)
+    cnt = np.zeros(2, dtype=np.int64)
+    buf = np.empty(4)
+    changed = np.empty(3, dtype=np.int64)
+    tpos = np.zeros(1, dtype=np.int64)
+    for s in slots:
+        _touch(s, ptr, adj, dirty, pending, span, window, cnt)
+    ok = _drain(op, out, a, b, param, lo, hi, ptr, adj, dirty, pending, span, window, rel_eps,
+                buf, changed, cnt, np.iinfo(np.int64).max, tpos[:0], buf[:0], tpos, piecewise,
+                pown, explog, trig)
+    stats[0] = cnt[1]
+    return DONE if ok else EMPTY

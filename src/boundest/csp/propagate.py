@@ -1,5 +1,6 @@
 """Propagation of a CSP to a fixed point: hull consistency on its primitive decomposition
-(``mode="hc4"``), or 3B consistency by shaving on top of it (``mode="3b"``)."""
+(``mode="hc4"``), and on top of it box consistency (``"bc"``), 3B consistency by shaving
+(``"3b"``), both (``"bc+3b"``), or LP contraction of the linear sub-networks (``"lp"``)."""
 
 from __future__ import annotations
 
@@ -12,12 +13,25 @@ from ..expr.model import Model
 from ..expr.nodes import Constraint
 from ..expr.tape import Tape, compile_model
 from ..interval import Interval
-from .engine import EMPTY, RUNNING, SHAVE_STATS, family_flags, propagate_kernel, shave_kernel
+from .engine import (
+    BC_STATS,
+    EMPTY,
+    RUNNING,
+    SHAVE_STATS,
+    bc_closures,
+    bc_kernel,
+    family_flags,
+    propagate_kernel,
+    repropagate_kernel,
+    shave_kernel,
+)
 
-__all__ = ["MODES", "Propagation", "Shaving", "propagate", "slot_users"]
+__all__ = ["MODES", "BoxConsistency", "LinearRelaxation", "Propagation", "Shaving",
+           "arg_users", "bc_candidates", "propagate", "slot_users"]
 
-#: The propagation modes: hull consistency alone, or 3B shaving after it.
-MODES = ("hc4", "3b")
+#: The propagation modes: hull consistency alone, then box consistency, 3B shaving, box
+#: consistency and shaving, or LP contraction (see ``propagate``).
+MODES = ("hc4", "bc", "3b", "bc+3b", "lp")
 
 
 @dataclass(frozen=True)
@@ -64,6 +78,80 @@ class Shaving:
             raise ValueError("reach and min_gain must be non-negative")
 
 
+@dataclass(frozen=True)
+class BoxConsistency:
+    """Settings of box consistency (``propagate(mode="bc")``; ``engine.bc_kernel`` details
+    them).
+
+    Attributes
+    ----------
+    depth : int
+        Bisections of a domain at most (1..52): a bound is narrowed to a slice
+        ``2**-depth`` of its domain wide (a relative precision, like ``rel_eps``).
+    max_steps : int
+        Evaluations of the sub-network per bound at most; a search cut short keeps what it
+        refuted.
+    max_nodes : int
+        Nodes of a variable's sub-network at most (the constraints it occurs in, up to the
+        other variables narrowed, ``targets``; breadth first from the variable).
+    rounds : int
+        Rounds over the candidates at most.
+    reach : int
+        A candidate is narrowed again in the next round when it or one within ``reach``
+        positions of it lost more than ``min_gain`` of its width.
+    min_gain : float
+        Relative width a candidate must lose in a round for the round to count as paying.
+    """
+
+    depth: int = 10
+    max_steps: int = 60
+    max_nodes: int = 64
+    rounds: int = 3
+    reach: int = 12
+    min_gain: float = 0.05
+
+    def __post_init__(self) -> None:
+        if not 1 <= self.depth <= 52:
+            raise ValueError(f"depth must lie in 1..52, got {self.depth}")
+        for name in ("max_steps", "max_nodes", "rounds"):
+            if getattr(self, name) < 1:
+                raise ValueError(f"{name} must be at least 1, got {getattr(self, name)}")
+        if self.reach < 0 or self.min_gain < 0:
+            raise ValueError("reach and min_gain must be non-negative")
+
+
+@dataclass(frozen=True)
+class LinearRelaxation:
+    """Settings of LP contraction (``propagate(mode="lp")``, ``ctc.linear.contract_slots``).
+
+    Attributes
+    ----------
+    rounds : int
+        LP contractions at most, each followed by propagation of what it narrowed.
+    min_gain : float
+        Stop when a round (LP and propagation) narrows the targets' total width by less than
+        this fraction.
+    radius : int, optional
+        Each target's LPs use the rows within this many row-steps of it (default: the whole
+        connected sub-network).
+    log_linear : bool
+        Also use the log-linear rows of multiplicative constraints (Jaulin 2002 eq. 19).
+    """
+
+    rounds: int = 3
+    min_gain: float = 0.01
+    radius: int | None = None
+    log_linear: bool = True
+
+    def __post_init__(self) -> None:
+        if self.rounds < 1:
+            raise ValueError(f"rounds must be at least 1, got {self.rounds}")
+        if self.min_gain < 0:
+            raise ValueError("min_gain must be non-negative")
+        if self.radius is not None and self.radius < 1:
+            raise ValueError(f"radius must be at least 1, got {self.radius}")
+
+
 @dataclass
 class Propagation:
     """Result of ``propagate``.
@@ -81,11 +169,22 @@ class Propagation:
     time_s : float
         Wall time of the propagation (compilation of the model excluded).
     mode : str
-        ``"hc4"`` or ``"3b"`` (see ``propagate``).
+        One of :data:`MODES` (see ``propagate``).
     shaving : dict
-        With ``mode="3b"``: the counters of the shaving phase (``engine.SHAVE_STATS``: rounds,
-        probes, slices refuted, revisions spent in probes, revisions in all) and its time
-        ``time_s`` (included in the propagation's ``time_s``); empty otherwise.
+        With ``mode="3b"`` or ``"bc+3b"``: the counters of the shaving phase
+        (``engine.SHAVE_STATS``: rounds, probes, slices refuted, revisions spent in probes,
+        revisions in all) and its time ``time_s`` (included in the propagation's ``time_s``);
+        empty otherwise.
+    boxcons : dict
+        With ``mode="bc"`` or ``"bc+3b"``: the counters of the box-consistency phase
+        (``engine.BC_STATS``: rounds, BC3 searches, significant narrowings, node evaluations
+        in the searches, revisions of the propagation), ``candidates`` (variables occurring
+        several times in their constraints) and its time ``time_s``; empty otherwise.
+    linear : dict
+        With ``mode="lp"``: ``rounds`` (LP contractions), ``lp_time_s`` (extraction, solves,
+        rigorous bounds), ``evaluations`` (revisions propagating what the LPs narrowed),
+        ``widths`` (the targets' total width after hull consistency and after each round) and
+        ``time_s``; empty otherwise.
     """
 
     domains: dict[str, Interval]
@@ -98,6 +197,8 @@ class Propagation:
     slots: Interval = field(repr=False)
     mode: str = "hc4"
     shaving: dict = field(default_factory=dict)
+    boxcons: dict = field(default_factory=dict)
+    linear: dict = field(default_factory=dict)
 
     def __getitem__(self, name: str) -> Interval:
         return self.domains[name]
@@ -130,11 +231,41 @@ def slot_users(tape: Tape) -> tuple[np.ndarray, np.ndarray]:
     return np.cumsum(ptr), nodes
 
 
+def arg_users(tape: Tape) -> tuple[np.ndarray, np.ndarray]:
+    """CSR lists of the nodes that read each slot as an argument (each node once per slot)."""
+    slots = np.concatenate([tape.a, tape.b]).astype(np.int64)
+    nodes = np.tile(np.arange(tape.n_nodes, dtype=np.int64), 2)
+    keep = (slots >= 0) & ~((np.arange(slots.size) >= tape.n_nodes)
+                            & (slots == np.concatenate([tape.a, tape.a])))
+    slots, nodes = slots[keep], nodes[keep]
+    order = np.lexsort((nodes, slots))
+    ptr = np.zeros(tape.n_slots + 1, dtype=np.int64)
+    np.add.at(ptr, slots + 1, 1)
+    return np.cumsum(ptr), nodes[order]
+
+
+def bc_candidates(tape: Tape, slots: np.ndarray, max_nodes: int
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The slots among ``slots`` that occur several times in their constraints, with their
+    sub-networks (``engine.bc_closures``, which stop at ``slots``: a variable's constraints
+    reach up to the other variables narrowed, through any other named variable, such as a
+    measured output that names a sub-expression): ``(cand, cptr, cnodes)``."""
+    aptr, aadj = arg_users(tape)
+    slots = np.asarray(slots, dtype=np.int64)
+    stop = np.zeros(tape.n_slots, dtype=np.bool_)
+    stop[slots] = True
+    keep, cptr, cnodes = bc_closures(tape.out, tape.a, tape.b, aptr, aadj, stop, slots,
+                                     int(max_nodes))
+    return slots[keep], cptr, cnodes
+
+
 def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
               max_evaluations: int | None = None, domains: dict[str, Interval] | None = None,
               progress: bool | None = None, chunk: int = 2_000_000, window: int = 64,
               mode: str = "hc4", shave: list[str] | None = None,
-              shaving: Shaving | None = None) -> Propagation:
+              shaving: Shaving | None = None, targets: list[str] | None = None,
+              boxcons: BoxConsistency | None = None,
+              linear: LinearRelaxation | None = None) -> Propagation:
     """Contract all domains of a CSP to a fixed point.
 
     ``mode="hc4"`` is hull consistency: every primitive node revised until nothing moves.
@@ -145,6 +276,20 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
     trail), so the cost per variable does not grow with the size of the CSP. It is tighter
     where hull consistency suffers from the dependency problem or from the locality of its
     constraints (a variable that occurs several times, a sign that only the next steps decide).
+
+    ``mode="bc"`` adds box consistency (BC3, Benhamou et al. 1999) after hull consistency:
+    each variable of ``targets`` that occurs several times in its constraints has its bounds
+    narrowed to the outermost slices whose image by the natural interval extension of those
+    constraints (the sub-network of nodes it reaches, up to the other ``targets``) meets the
+    domains; what it narrows is propagated by hull consistency, round after round while it
+    pays (``engine.bc_kernel``). Each search is local and bounded (``boxcons``), so its cost
+    per variable does not grow with the CSP. ``mode="bc+3b"`` runs box consistency, then
+    shaving. ``mode="lp"`` contracts the linear and log-linear sub-networks by LPs at hull
+    consistency's fixed point (``ctc.linear.contract_slots``, needs SciPy: ``pip install
+    'boundest[lp]'``) and propagates only what they narrowed (the users of the narrowed slots
+    become dirty), up to ``linear.rounds`` times while it pays; unlike ``csp.linear.
+    propagate_lp`` it never restarts propagation from scratch. The LPs are global: their cost
+    grows faster than the CSP.
 
     Stopping rule: a node is revised again only when one of its slots shrank by more than
     ``rel_eps`` times its width (or lost an infinite bound); propagation stops when no such
@@ -169,13 +314,22 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
         Consecutive tape nodes brought to their local fixed point together before a pass moves
         on (see ``engine.propagate_kernel``); 64 nodes is about three time steps of the
         satellite.
-    mode : {"hc4", "3b"}
-        Hull consistency alone, or followed by shaving.
+    mode : {"hc4", "bc", "3b", "bc+3b", "lp"}
+        Hull consistency alone, or followed by box consistency, shaving, both, or LPs.
     shave : list of str, optional
         With ``mode="3b"``: the variables to shave, in the order they are visited (for a time
         series, by time step; default: every variable of the model in its order).
     shaving : Shaving, optional
         With ``mode="3b"``: the shaving settings (default ``Shaving()``).
+    targets : list of str, optional
+        With ``mode="bc"`` or ``"bc+3b"``: the variables box consistency narrows (those among
+        them that occur several times; default: every variable); with ``mode="lp"``: the
+        variables the LPs contract (default: every variable; each costs two LPs, four where it
+        is sign-definite and in a log-linear row).
+    boxcons : BoxConsistency, optional
+        With ``mode="bc"`` or ``"bc+3b"``: the settings (default ``BoxConsistency()``).
+    linear : LinearRelaxation, optional
+        With ``mode="lp"``: the settings (default ``LinearRelaxation()``).
     """
     if mode not in MODES:
         raise ValueError(f"mode must be one of {', '.join(MODES)}, got {mode!r}")
@@ -184,6 +338,10 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
     if window < 1:
         raise ValueError(f"window must be a positive number of nodes, got {window}")
     tape = model if isinstance(model, Tape) else compile_model(model)
+    if mode == "lp":
+        from ..ctc.linear import _linprog
+
+        _linprog()  # fails before any work, naming the extra, when SciPy is missing
     lo, hi = tape.lo.copy(), tape.hi.copy()
     for name, dom in (domains or {}).items():
         if name not in tape.slot_of:
@@ -203,8 +361,18 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
     # a zero-budget call compiles (first use) or loads the kernel outside the timed part
     propagate_kernel(tape.op, tape.out, tape.a, tape.b, tape.param, lo, hi, ptr, adj, dirty,
                      state.copy(), rel_eps, 0, window, *families)
-    if mode == "3b":  # the same for the shaving kernel, on an empty tape of the same types
-        e = slice(0, 0)
+    e = slice(0, 0)
+    if mode in ("bc", "bc+3b"):  # the same for the other kernels, on an empty tape
+        bc_closures(tape.out[e], tape.a[e], tape.b[e], ptr[:1], adj[e], np.zeros(0, np.bool_),
+                    adj[e], 1)
+        bc_kernel(tape.op[e], tape.out[e], tape.a[e], tape.b[e], tape.param[e], lo[e], hi[e],
+                  ptr[:1], adj[e], adj[e], ptr[:1], adj[e], rel_eps, 0.0, 1, 1, 1, 0, 0.0,
+                  window, np.zeros(len(BC_STATS), dtype=np.int64), *families)
+    if mode == "lp":
+        repropagate_kernel(tape.op[e], tape.out[e], tape.a[e], tape.b[e], tape.param[e], lo[e],
+                           hi[e], ptr[:1], adj[e], adj[e], rel_eps, window,
+                           np.zeros(1, dtype=np.int64), *families)
+    if mode in ("3b", "bc+3b"):
         shave_kernel(tape.op[e], tape.out[e], tape.a[e], tape.b[e], tape.param[e], lo[e], hi[e],
                      ptr[:1], adj[e], np.zeros(0, dtype=np.int64), rel_eps, rel_eps, 1, 0.5, 1,
                      0, 0.0, window, np.zeros(len(SHAVE_STATS), dtype=np.int64), *families)
@@ -229,7 +397,28 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
         bar.close()
     evaluations = int(state[3])
     shave_info: dict = {}
-    if mode == "3b" and status != EMPTY and n > 0:
+    bc_info: dict = {}
+    lp_info: dict = {}
+    if mode in ("bc", "bc+3b") and status != EMPTY and n > 0:
+        opts_bc = boxcons or BoxConsistency()
+        t1 = time.perf_counter()
+        cand, cptr, cnodes = bc_candidates(tape, _shave_slots(tape, targets, "targets"),
+                                           opts_bc.max_nodes)
+        stats = np.zeros(len(BC_STATS), dtype=np.int64)
+        status = bc_kernel(tape.op, tape.out, tape.a, tape.b, tape.param, lo, hi, ptr, adj,
+                           cand, cptr, cnodes, rel_eps, 0.0, int(opts_bc.depth),
+                           int(opts_bc.max_steps), int(opts_bc.rounds), int(opts_bc.reach),
+                           float(opts_bc.min_gain), window, stats, *families)
+        bc_info = {k: int(v) for k, v in zip(BC_STATS, stats, strict=True)}
+        bc_info["candidates"] = int(cand.size)
+        bc_info["time_s"] = time.perf_counter() - t1
+        evaluations += int(stats[-1])
+    if mode == "lp" and status != EMPTY and n > 0:
+        status, lp_info = _lp_rounds(tape, lo, hi, ptr, adj, families, rel_eps, window,
+                                     _shave_slots(tape, targets, "targets"),
+                                     linear or LinearRelaxation())
+        evaluations += lp_info["evaluations"]
+    if mode in ("3b", "bc+3b") and status != EMPTY and n > 0:
         cand = _shave_slots(tape, shave)
         opts = shaving or Shaving()
         stats = np.zeros(len(SHAVE_STATS), dtype=np.int64)
@@ -250,16 +439,57 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
     return Propagation(domains=doms, consistent=consistent, evaluations=evaluations,
                        iterations=evaluations / max(n, 1), time_s=elapsed, n_nodes=n,
                        n_slots=tape.n_slots, slots=Interval._new(lo, hi), mode=mode,
-                       shaving=shave_info)
+                       shaving=shave_info, boxcons=bc_info, linear=lp_info)
 
 
-def _shave_slots(tape: Tape, names: list[str] | None) -> np.ndarray:
+def _lp_rounds(tape: Tape, lo: np.ndarray, hi: np.ndarray, ptr: np.ndarray, adj: np.ndarray,
+               families: tuple, rel_eps: float, window: int, slots: np.ndarray,
+               opts: LinearRelaxation) -> tuple[int, dict]:
+    """LP contraction at the fixed point, then propagation of the slots it narrowed, in place
+    on ``lo``/``hi``, while a round pays. Returns the status and the counters."""
+    from ..ctc.linear import contract_slots
+
+    t0 = time.perf_counter()
+    lp_time, evals, done = 0.0, 0, 0
+    widths = [float(np.sum(hi[slots] - lo[slots]))]
+    status = RUNNING
+    stats = np.zeros(1, dtype=np.int64)
+    while done < opts.rounds:
+        t1 = time.perf_counter()
+        nlo, nhi, ok = contract_slots(tape, lo, hi, slots, opts.log_linear, opts.radius)
+        lp_time += time.perf_counter() - t1
+        done += 1
+        if not ok:
+            status = EMPTY
+            break
+        w0, w1 = hi - lo, nhi - nlo
+        with np.errstate(invalid="ignore"):
+            moved = (nlo != lo) | (nhi != hi)
+            sig = moved & ((w0 == np.inf) | (w0 - w1 > rel_eps * w0))
+        lo[:], hi[:] = nlo, nhi
+        status = repropagate_kernel(tape.op, tape.out, tape.a, tape.b, tape.param, lo, hi, ptr,
+                                    adj, np.flatnonzero(sig).astype(np.int64), rel_eps, window,
+                                    stats, *families)
+        evals += int(stats[0])
+        if status == EMPTY:
+            break
+        widths.append(float(np.sum(hi[slots] - lo[slots])))
+        if not widths[-1] < (1.0 - opts.min_gain) * widths[-2]:
+            break
+    info = {"rounds": done, "lp_time_s": lp_time, "evaluations": evals, "widths": widths,
+            "settings": {"rounds": opts.rounds, "min_gain": opts.min_gain,
+                         "radius": opts.radius, "log_linear": opts.log_linear},
+            "time_s": time.perf_counter() - t0}
+    return status, info
+
+
+def _shave_slots(tape: Tape, names: list[str] | None, arg: str = "shave") -> np.ndarray:
     """The slots of the variables ``names`` (default: all), each once, in that order."""
     if names is None:
         names = list(tape.slot_of)
     unknown = [v for v in names if v not in tape.slot_of]
     if unknown:
-        raise ValueError(f"unknown variable {unknown[0]!r} in shave")
+        raise ValueError(f"unknown variable {unknown[0]!r} in {arg}")
     slots = np.array([tape.slot_of[v] for v in names], dtype=np.int64)
     _, first = np.unique(slots, return_index=True)
     return slots[np.sort(first)]
