@@ -24,8 +24,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _machine import cpu_model, emit
 
 from boundest import Interval
-from boundest.ctc import CtcBox, CtcFwdBwd, CtcShave, Fixpoint
-from boundest.ctc.boxcons import occurrences
+from boundest.csp import CtcBox
+from boundest.csp.boxcons import occurrences
+from boundest.ctc import CtcFwdBwd, CtcShave, Fixpoint
 from boundest.expr import Var
 from boundest.expr.functions import cos, sin, sqr
 

@@ -12,8 +12,9 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from boundest import Interval
-from boundest.ctc import CtcBox, CtcFwdBwd, Fixpoint
-from boundest.ctc.boxcons import occurrences
+from boundest.csp import CtcBox
+from boundest.csp.boxcons import occurrences
+from boundest.ctc import CtcFwdBwd, Fixpoint
 from boundest.expr import Model, Var
 from boundest.expr.functions import sqr
 

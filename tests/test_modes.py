@@ -14,9 +14,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from boundest import Interval
-from boundest.csp import MODES, BoxConsistency, LinearRelaxation, Shaving, propagate
+from boundest.csp import MODES, BoxConsistency, CtcBox, LinearRelaxation, Shaving, propagate
 from boundest.csp.linear import propagate_lp
-from boundest.ctc import CtcBox
 from boundest.expr import Model, Var
 from boundest.expr.functions import sqr
 

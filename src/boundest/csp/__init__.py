@@ -1,8 +1,10 @@
-"""Constraint networks and their propagation; FALL/CLIMB on trees; beta-tuning."""
+"""Constraint networks and their propagation (hull consistency, box consistency, shaving, LP);
+FALL/CLIMB on trees; beta-tuning."""
 
 from .beta import BetaResult, beta_tuning
+from .boxcons import CtcBox
 from .propagate import MODES, BoxConsistency, LinearRelaxation, Propagation, Shaving, propagate
 from .tree import Arc, TreeSCSP
 
-__all__ = ["MODES", "Arc", "BetaResult", "BoxConsistency", "LinearRelaxation", "Propagation",
-           "Shaving", "TreeSCSP", "beta_tuning", "propagate"]
+__all__ = ["MODES", "Arc", "BetaResult", "BoxConsistency", "CtcBox", "LinearRelaxation",
+           "Propagation", "Shaving", "TreeSCSP", "beta_tuning", "propagate"]

@@ -1,9 +1,8 @@
 """Contractors: forward-backward on a tape, composition, fixpoint, inflation, q-relaxed
-intersection, 3B shaving, box consistency (BC3); LP contraction of linear / log-linear
+intersection, 3B shaving; LP contraction of linear / log-linear
 sub-networks; the range sensor (first-hit distance along a ray of an obstacle map)."""
 
 from .base import Contractor, Fixpoint, FunctionContractor, Inflate, Sequence, Union, shrink_ratio
-from .boxcons import CtcBox
 from .fwdbwd import CtcFwdBwd
 from .linear import CtcLinear
 from .obstacles import ObstacleMap
@@ -11,6 +10,6 @@ from .qinter import CtcQInter
 from .raycast import CtcRayCast
 from .shave import CtcShave
 
-__all__ = ["Contractor", "CtcBox", "CtcFwdBwd", "CtcLinear", "CtcQInter", "CtcRayCast",
+__all__ = ["Contractor", "CtcFwdBwd", "CtcLinear", "CtcQInter", "CtcRayCast",
            "CtcShave", "Fixpoint", "FunctionContractor", "Inflate", "ObstacleMap", "Sequence",
            "Union", "shrink_ratio"]

@@ -31,12 +31,14 @@ from collections.abc import Sequence as Seq
 
 import numpy as np
 
+from ..ctc.base import Contractor, _empty_rows
+from ..ctc.revise import family_flags
 from ..expr.model import Model
 from ..expr.nodes import Constraint, Expr, Op, Var
 from ..expr.tape import compile_model
 from ..interval import Interval
-from .base import Contractor, _empty_rows
-from .revise import family_flags
+from .engine import bc_boxes
+from .propagate import bc_candidates
 
 __all__ = ["CtcBox", "occurrences"]
 
@@ -116,8 +118,6 @@ class CtcBox(Contractor):
                              f"{', '.join(missing)}")
         self.variables, self.n = names, len(names)
         self.eps, self.max_depth, self.max_steps = float(eps), int(max_depth), int(max_steps)
-        from ..csp.propagate import bc_candidates  # the csp layer builds on this one
-
         self._tape = compile_model(model)
         self._slot = np.array([self._tape.slot_of[v] for v in names], dtype=np.int64)
         # every node a variable reaches (no truncation: these are small constraint sets)
@@ -139,8 +139,6 @@ class CtcBox(Contractor):
         if np.isnan(t.lo).any():  # the constraints alone are inconsistent
             lo[:] = hi[:] = np.nan
         else:
-            from ..csp.engine import bc_boxes
-
             bc_boxes(t.op, t.out, t.a, t.b, t.param, t.lo, t.hi, self._slot, lo, hi, self._cand,
                      self._cptr, self._cnodes, self.eps, self.max_depth, self.max_steps,
                      *self._families)
