@@ -43,7 +43,7 @@ def same(z: Interval, lo: float, hi: float) -> bool:
 
 def engine_forward(name: str, x: Interval) -> Interval:
     """Images of the scalar intervals of ``x`` through the compiled engine's forward step: its
-    family's revise kernel, image step only, with ``z`` entire: its new ``z`` is the image."""
+    family's revise kernel with ``z`` entire, whose new ``z`` is then the image itself."""
     from boundest.ctc import revise as engine
 
     code = getattr(engine, name.upper())
@@ -52,5 +52,5 @@ def engine_forward(name: str, x: Interval) -> Interval:
     lo, hi = np.empty(x.lo.size), np.empty(x.lo.size)
     for i in range(x.lo.size):
         lo[i], hi[i] = revise(code, -np.inf, np.inf, float(x.lo.flat[i]), float(x.hi.flat[i]),
-                              0.0, 0.0, buf, True, None)[:2]
+                              0.0, 0.0, buf)[:2]
     return Interval._new(lo, hi)

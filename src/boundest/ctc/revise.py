@@ -6,8 +6,6 @@ one node ``z = f(x, y)`` (``z ∩= f(x, y)``, then ``(x, y) = f_rev(z, x, y)``),
 revises every node of a tape once forward and once backward on one box's slots. The ops are in
 families (:data:`FAMILIES`); a caller passes ``True`` for the families its tape uses and
 ``None`` for the others, whose kernels Numba then neither compiles nor loads.
-``revise_steps`` runs one of the two steps of a revision alone: :class:`boundest.ctc.CtcFwdBwd`
-runs the classic HC4 pass with it (every image forward, then every projection backward).
 """
 
 from __future__ import annotations
@@ -23,7 +21,7 @@ from ..interval import arith as ar
 from ..interval import explog as el
 from ..interval import trig as tr
 
-__all__ = ["FAMILIES", "OP_CODES", "family_flags", "hc4_pass", "revise", "revise_steps"]
+__all__ = ["FAMILIES", "OP_CODES", "family_flags", "hc4_pass", "revise"]
 
 OP_CODES = _C = {name: i for i, name in enumerate(OPS)}
 NEG, SQR, SQRT, EXP, LOG, SIN, COS, TAN = (_C[k] for k in
@@ -84,153 +82,121 @@ def _cap(zl, zh, nl, nh):
     return (max(nl, zl) if nl == nl else nl), (min(nh, zh) if nh == nh else nh)
 
 
-# The steps of a revision: each kernel below takes ``img`` and ``prj``, ``True`` or ``None``.
-# With ``img`` it intersects ``z`` with the image ``f(x, y)``, with ``prj`` it then projects
-# ``z`` back onto ``(x, y)``; Numba prunes the step given ``None`` before compiling, so
-# ``revise`` (both steps) and the two sweeps of ``CtcFwdBwd`` (one step each) share one
-# implementation of every op.
-
-
 @nb.njit(cache=True, error_model="numpy")
-def _revise_piecewise(code, zl, zh, xl, xh, yl, yh, img, prj):
+def _revise_piecewise(code, zl, zh, xl, xh, yl, yh):
     """HC4-revise of the piecewise nodes (abs, sign, floor, ceil, min, max)."""
     if code == MIN:
-        if img is not None:
-            nl, nh = al._min_all(xl, xh, yl, yh)
-            zl, zh = _cap(zl, zh, nl, nh)
-        if prj is not None:
-            xl, xh, yl, yh = al._min_rev_all(zl, zh, xl, xh, yl, yh)
+        nl, nh = al._min_all(xl, xh, yl, yh)
+        zl, zh = _cap(zl, zh, nl, nh)
+        xl, xh, yl, yh = al._min_rev_all(zl, zh, xl, xh, yl, yh)
     elif code == MAX:
-        if img is not None:
-            nl, nh = al._max_all(xl, xh, yl, yh)
-            zl, zh = _cap(zl, zh, nl, nh)
-        if prj is not None:
-            xl, xh, yl, yh = al._max_rev_all(zl, zh, xl, xh, yl, yh)
+        nl, nh = al._max_all(xl, xh, yl, yh)
+        zl, zh = _cap(zl, zh, nl, nh)
+        xl, xh, yl, yh = al._max_rev_all(zl, zh, xl, xh, yl, yh)
     elif code == ABS:
-        if img is not None:
-            nl, nh = al._abs_all(xl, xh)
-            zl, zh = _cap(zl, zh, nl, nh)
-        if prj is not None:
-            xl, xh = al._abs_rev_all(zl, zh, xl, xh)
+        nl, nh = al._abs_all(xl, xh)
+        zl, zh = _cap(zl, zh, nl, nh)
+        xl, xh = al._abs_rev_all(zl, zh, xl, xh)
     elif code == SIGN:
-        if img is not None:
-            nl, nh = al._sign_all(xl, xh)
-            zl, zh = _cap(zl, zh, nl, nh)
-        if prj is not None:
-            xl, xh = al._sign_rev_all(zl, zh, xl, xh)
+        nl, nh = al._sign_all(xl, xh)
+        zl, zh = _cap(zl, zh, nl, nh)
+        xl, xh = al._sign_rev_all(zl, zh, xl, xh)
     elif code == FLOOR:
-        if img is not None:
-            nl, nh = al._floor_all(xl, xh)
-            zl, zh = _cap(zl, zh, nl, nh)
-        if prj is not None:
-            xl, xh = al._floor_rev_all(zl, zh, xl, xh)
+        nl, nh = al._floor_all(xl, xh)
+        zl, zh = _cap(zl, zh, nl, nh)
+        xl, xh = al._floor_rev_all(zl, zh, xl, xh)
     elif code == CEIL:
-        if img is not None:
-            nl, nh = al._ceil_all(xl, xh)
-            zl, zh = _cap(zl, zh, nl, nh)
-        if prj is not None:
-            xl, xh = al._ceil_rev_all(zl, zh, xl, xh)
+        nl, nh = al._ceil_all(xl, xh)
+        zl, zh = _cap(zl, zh, nl, nh)
+        xl, xh = al._ceil_rev_all(zl, zh, xl, xh)
     return zl, zh, xl, xh, yl, yh
 
 
 @nb.njit(cache=True, error_model="numpy")
-def _revise_pown(zl, zh, xl, xh, p, buf, img, prj):
+def _revise_pown(zl, zh, xl, xh, p, buf):
     """HC4-revise of a ``pown`` node (integer exponent ``p``)."""
     o0, o1 = buf[0:1], buf[1:2]
-    if img is not None:
-        _f_pown(xl, xh, np.int64(p), o0, o1)
-        zl, zh = _cap(zl, zh, buf[0], buf[1])
-    if prj is not None:
-        _b_pown(zl, zh, xl, xh, np.int64(p), o0, o1)
-        xl, xh = buf[0], buf[1]
-    return zl, zh, xl, xh
+    _f_pown(xl, xh, np.int64(p), o0, o1)
+    zl, zh = _cap(zl, zh, buf[0], buf[1])
+    _b_pown(zl, zh, xl, xh, np.int64(p), o0, o1)
+    return zl, zh, buf[0], buf[1]
 
 
 @nb.njit(cache=True, error_model="numpy")
-def _revise_explog(code, zl, zh, xl, xh, yl, yh, buf, img, prj):
+def _revise_explog(code, zl, zh, xl, xh, yl, yh, buf):
     """HC4-revise of the exponential family (exp, log, sinh, cosh, tanh, atan, atan2, and the
     real power ``pow(x, y) = exp(y log x)``)."""
     o0, o1, o2, o3 = buf[0:1], buf[1:2], buf[2:3], buf[3:4]
-    if code in (POW, ATAN2):
-        if img is not None:
-            if code == POW:
-                _f_pow(xl, xh, yl, yh, o0, o1)
-            else:
-                _f_atan2(xl, xh, yl, yh, o0, o1)
-            zl, zh = _cap(zl, zh, buf[0], buf[1])
-        if prj is not None:
-            if code == POW:
-                _b_pow(zl, zh, xl, xh, yl, yh, o0, o1, o2, o3)
-            else:
-                _b_atan2(zl, zh, xl, xh, yl, yh, o0, o1, o2, o3)
-            xl, xh, yl, yh = buf[0], buf[1], buf[2], buf[3]
+    if code == POW:
+        _f_pow(xl, xh, yl, yh, o0, o1)
+        zl, zh = _cap(zl, zh, buf[0], buf[1])
+        _b_pow(zl, zh, xl, xh, yl, yh, o0, o1, o2, o3)
+        return zl, zh, buf[0], buf[1], buf[2], buf[3]
+    if code == ATAN2:
+        _f_atan2(xl, xh, yl, yh, o0, o1)
+        zl, zh = _cap(zl, zh, buf[0], buf[1])
+        _b_atan2(zl, zh, xl, xh, yl, yh, o0, o1, o2, o3)
+        return zl, zh, buf[0], buf[1], buf[2], buf[3]
+    if code == EXP:
+        nl, nh = _f_exp(xl, xh, math.exp(xl), math.exp(xh))
+    elif code == LOG:
+        nl, nh = _f_log(xl, xh, math.log(xl), math.log(xh))
+    elif code == SINH:
+        nl, nh = _f_sinh(xl, xh, math.sinh(xl), math.sinh(xh))
+    elif code == COSH:
+        nl, nh = _f_cosh(xl, xh, math.cosh(xl), math.cosh(xh))
+    elif code == TANH:
+        nl, nh = _f_tanh(xl, xh, math.tanh(xl), math.tanh(xh))
+    elif code == ATAN:
+        nl, nh = _f_atan(xl, xh, math.atan(xl), math.atan(xh))
+    else:
         return zl, zh, xl, xh, yl, yh
-    if code not in (EXP, LOG, SINH, COSH, TANH, ATAN):
-        return zl, zh, xl, xh, yl, yh
-    if img is not None:
-        if code == EXP:
-            nl, nh = _f_exp(xl, xh, math.exp(xl), math.exp(xh))
-        elif code == LOG:
-            nl, nh = _f_log(xl, xh, math.log(xl), math.log(xh))
-        elif code == SINH:
-            nl, nh = _f_sinh(xl, xh, math.sinh(xl), math.sinh(xh))
-        elif code == COSH:
-            nl, nh = _f_cosh(xl, xh, math.cosh(xl), math.cosh(xh))
-        elif code == TANH:
-            nl, nh = _f_tanh(xl, xh, math.tanh(xl), math.tanh(xh))
-        else:  # ATAN
-            nl, nh = _f_atan(xl, xh, math.atan(xl), math.atan(xh))
-        zl, zh = _cap(zl, zh, nl, nh)
-    if prj is not None:
-        if code == EXP:
-            _b_exp(zl, zh, xl, xh, o0, o1)
-        elif code == LOG:
-            _b_log(zl, zh, xl, xh, o0, o1)
-        elif code == SINH:
-            _b_sinh(zl, zh, xl, xh, o0, o1)
-        elif code == COSH:
-            _b_cosh(zl, zh, xl, xh, o0, o1)
-        elif code == TANH:
-            _b_tanh(zl, zh, xl, xh, o0, o1)
-        else:  # ATAN
-            _b_atan(zl, zh, xl, xh, o0, o1)
-        xl, xh = buf[0], buf[1]
-    return zl, zh, xl, xh, yl, yh
+    zl, zh = _cap(zl, zh, nl, nh)
+    if code == EXP:
+        _b_exp(zl, zh, xl, xh, o0, o1)
+    elif code == LOG:
+        _b_log(zl, zh, xl, xh, o0, o1)
+    elif code == SINH:
+        _b_sinh(zl, zh, xl, xh, o0, o1)
+    elif code == COSH:
+        _b_cosh(zl, zh, xl, xh, o0, o1)
+    elif code == TANH:
+        _b_tanh(zl, zh, xl, xh, o0, o1)
+    else:  # ATAN
+        _b_atan(zl, zh, xl, xh, o0, o1)
+    return zl, zh, buf[0], buf[1], yl, yh
 
 
 @nb.njit(cache=True, error_model="numpy")
-def _revise_trig(code, zl, zh, xl, xh, yl, yh, buf, img, prj):
+def _revise_trig(code, zl, zh, xl, xh, yl, yh, buf):
     """HC4-revise of the trigonometric family (sin, cos, tan, asin, acos)."""
-    if code not in (SIN, COS, TAN, ASIN, ACOS):
-        return zl, zh, xl, xh, yl, yh
     o0, o1 = buf[0:1], buf[1:2]
-    if img is not None:
-        if code == SIN:
-            _f_sin(xl, xh, o0, o1)
-        elif code == COS:
-            _f_cos(xl, xh, o0, o1)
-        elif code == TAN:
-            buf[0], buf[1] = _f_tan(xl, xh, math.tan(xl), math.tan(xh))
-        elif code == ASIN:
-            buf[0], buf[1] = _f_asin(xl, xh, math.asin(xl), math.asin(xh))
-        else:  # ACOS; asin is only used where |x| <= 1/2
-            buf[0], buf[1] = _f_acos(xl, xh, math.acos(xl), math.acos(xh),
-                                     math.asin(xl) if abs(xl) <= 0.5 else 0.0,
-                                     math.asin(xh) if abs(xh) <= 0.5 else 0.0)
-        zl, zh = _cap(zl, zh, buf[0], buf[1])
-    if prj is not None:
-        if code == SIN:
-            _b_sin(zl, zh, xl, xh, o0, o1)
-        elif code == COS:
-            _b_cos(zl, zh, xl, xh, o0, o1)
-        elif code == TAN:
-            _b_tan(zl, zh, xl, xh, o0, o1)
-        elif code == ASIN:
-            _b_asin(zl, zh, xl, xh, o0, o1)
-        else:  # ACOS
-            _b_acos(zl, zh, xl, xh, o0, o1)
-        xl, xh = buf[0], buf[1]
-    return zl, zh, xl, xh, yl, yh
+    if code == SIN:
+        _f_sin(xl, xh, o0, o1)
+    elif code == COS:
+        _f_cos(xl, xh, o0, o1)
+    elif code == TAN:
+        buf[0], buf[1] = _f_tan(xl, xh, math.tan(xl), math.tan(xh))
+    elif code == ASIN:
+        buf[0], buf[1] = _f_asin(xl, xh, math.asin(xl), math.asin(xh))
+    elif code == ACOS:  # asin is only used where |x| <= 1/2
+        buf[0], buf[1] = _f_acos(xl, xh, math.acos(xl), math.acos(xh),
+                                 math.asin(xl) if abs(xl) <= 0.5 else 0.0,
+                                 math.asin(xh) if abs(xh) <= 0.5 else 0.0)
+    else:
+        return zl, zh, xl, xh, yl, yh
+    zl, zh = _cap(zl, zh, buf[0], buf[1])
+    if code == SIN:
+        _b_sin(zl, zh, xl, xh, o0, o1)
+    elif code == COS:
+        _b_cos(zl, zh, xl, xh, o0, o1)
+    elif code == TAN:
+        _b_tan(zl, zh, xl, xh, o0, o1)
+    elif code == ASIN:
+        _b_asin(zl, zh, xl, xh, o0, o1)
+    else:  # ACOS
+        _b_acos(zl, zh, xl, xh, o0, o1)
+    return zl, zh, buf[0], buf[1], yl, yh
 
 
 @nb.njit(cache=True, error_model="numpy")
@@ -242,61 +208,37 @@ def revise(code, zl, zh, xl, xh, yl, yh, p, buf, piecewise, pown, explog, trig):
     ``explog``, ``trig``) is not ``None`` (Numba prunes ``x is not None`` on a ``None``
     argument before typing). A node of a family left out is not contracted, which is sound.
     """
-    return revise_steps(code, zl, zh, xl, xh, yl, yh, p, buf, True, True, piecewise, pown,
-                        explog, trig)
-
-
-@nb.njit(cache=True, error_model="numpy")
-def revise_steps(code, zl, zh, xl, xh, yl, yh, p, buf, img, prj, piecewise, pown, explog,
-                 trig):
-    """:func:`revise` with its two steps chosen: the image step ``z ∩= f(x, y)`` where ``img``
-    is ``True``, the projection ``(x, y) = f_rev(z, x, y)`` where ``prj`` is ``True``; a step
-    given ``None`` is skipped (and not compiled)."""
     if code == ADD:
-        if img is not None:
-            zl, zh = _cap(zl, zh, _add_lo(xl, xh, yl, yh), _add_hi(xl, xh, yl, yh))
-        if prj is not None:
-            xl, xh, yl, yh = al._add_rev_all(zl, zh, xl, xh, yl, yh)
+        zl, zh = _cap(zl, zh, _add_lo(xl, xh, yl, yh), _add_hi(xl, xh, yl, yh))
+        xl, xh, yl, yh = al._add_rev_all(zl, zh, xl, xh, yl, yh)
     elif code == MUL:
-        if img is not None:
-            zl, zh = _cap(zl, zh, _mul_lo(xl, xh, yl, yh), _mul_hi(xl, xh, yl, yh))
-        if prj is not None:
-            xl, xh, yl, yh = al._mul_rev_all(zl, zh, xl, xh, yl, yh)
+        zl, zh = _cap(zl, zh, _mul_lo(xl, xh, yl, yh), _mul_hi(xl, xh, yl, yh))
+        xl, xh, yl, yh = al._mul_rev_all(zl, zh, xl, xh, yl, yh)
     elif code == SUB:
-        if img is not None:
-            zl, zh = _cap(zl, zh, _sub_lo(xl, xh, yl, yh), _sub_hi(xl, xh, yl, yh))
-        if prj is not None:
-            xl, xh, yl, yh = al._sub_rev_all(zl, zh, xl, xh, yl, yh)
+        zl, zh = _cap(zl, zh, _sub_lo(xl, xh, yl, yh), _sub_hi(xl, xh, yl, yh))
+        xl, xh, yl, yh = al._sub_rev_all(zl, zh, xl, xh, yl, yh)
     elif code == DIV:
-        if img is not None:
-            zl, zh = _cap(zl, zh, _div_lo(xl, xh, yl, yh), _div_hi(xl, xh, yl, yh))
-        if prj is not None:
-            xl, xh, yl, yh = al._div_rev_all(zl, zh, xl, xh, yl, yh)
+        zl, zh = _cap(zl, zh, _div_lo(xl, xh, yl, yh), _div_hi(xl, xh, yl, yh))
+        xl, xh, yl, yh = al._div_rev_all(zl, zh, xl, xh, yl, yh)
     elif code == SQR:
-        if img is not None:
-            zl, zh = _cap(zl, zh, _sqr_lo(xl, xh), _sqr_hi(xl, xh))
-        if prj is not None:
-            xl, xh = al._sqr_rev_all(zl, zh, xl, xh)
+        zl, zh = _cap(zl, zh, _sqr_lo(xl, xh), _sqr_hi(xl, xh))
+        xl, xh = al._sqr_rev_all(zl, zh, xl, xh)
     elif code == SQRT:
-        if img is not None:
-            zl, zh = _cap(zl, zh, _sqrt_lo(xl, xh), _sqrt_hi(xl, xh))
-        if prj is not None:
-            xl, xh = al._sqrt_rev_all(zl, zh, xl, xh)
+        zl, zh = _cap(zl, zh, _sqrt_lo(xl, xh), _sqrt_hi(xl, xh))
+        xl, xh = al._sqrt_rev_all(zl, zh, xl, xh)
     elif code == NEG:
-        if img is not None:
-            zl, zh = _cap(zl, zh, -xh, -xl)
-        if prj is not None:
-            xl, xh = al._neg_rev_all(zl, zh, xl, xh)
+        zl, zh = _cap(zl, zh, -xh, -xl)
+        xl, xh = al._neg_rev_all(zl, zh, xl, xh)
     else:
         if pown is not None and code == POWN:
-            zl, zh, xl, xh = _revise_pown(zl, zh, xl, xh, p, buf, img, prj)
+            zl, zh, xl, xh = _revise_pown(zl, zh, xl, xh, p, buf)
             return zl, zh, xl, xh, yl, yh
         if piecewise is not None and code in (ABS, SIGN, FLOOR, CEIL, MIN, MAX):
-            return _revise_piecewise(code, zl, zh, xl, xh, yl, yh, img, prj)
+            return _revise_piecewise(code, zl, zh, xl, xh, yl, yh)
         if explog is not None and code in (EXP, LOG, SINH, COSH, TANH, ATAN, ATAN2, POW):
-            return _revise_explog(code, zl, zh, xl, xh, yl, yh, buf, img, prj)
+            return _revise_explog(code, zl, zh, xl, xh, yl, yh, buf)
         if trig is not None:
-            return _revise_trig(code, zl, zh, xl, xh, yl, yh, buf, img, prj)
+            return _revise_trig(code, zl, zh, xl, xh, yl, yh, buf)
     return zl, zh, xl, xh, yl, yh
 
 

@@ -2,7 +2,7 @@
 
 A constraint such as ``v = f(x, u)`` holds at every time, so for every slice (and every gate)
 the tuple of the tubes' values at that time lies in the box of their slices (gates). The box
-contractor (typically ``CtcFwdBwd``, batched: one compiled call over all the rows) runs once on the
+contractor (typically ``CtcFwdBwd``, batched: one NumPy call per tape node) runs once on the
 ``(2n+1, n_vars)`` batch of the slices and the gates.
 """
 
