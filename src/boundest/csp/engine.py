@@ -227,7 +227,7 @@ def _drain(op, out, a, b, param, lo, hi, ptr, adj, dirty, pending, span, window,
     """Revise the dirty nodes in alternating passes over the span of dirty windows only (it
     grows as changes spread and is trimmed between passes), until none is dirty or ``cnt[1]``
     reaches ``max_evals``. Returns False when a domain became empty."""
-    d = 1
+    d = np.int64(1)  # not the literal 1: _settle would be compiled again for Literal[int](1)
     while cnt[0] > 0 and cnt[1] < max_evals:
         w = span[0] if d > 0 else span[1]
         while span[0] <= w <= span[1] and cnt[1] < max_evals:
