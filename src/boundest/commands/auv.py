@@ -62,6 +62,8 @@ def run(args: argparse.Namespace) -> int:
     print(f"AUV survey: {data.n} samples over {data.n * data.dt:.0f} s, {data.fix_k.size} GPS "
           f"fixes, {data.det_k.size} detections of {data.n_mines} mines (data: {data.source}; "
           f"read in {time.perf_counter() - start:.2f} s)")
+    print("  hull consistency (box consistency of the attitudes narrows nothing here, at 10x "
+          "the time: benchmarks/README.md, AUV modes)")
     print("localization ...", flush=True)
     loc = auv.localize(data)
     _summary(loc, data)
