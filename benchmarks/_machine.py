@@ -16,11 +16,15 @@ def cpu_model() -> str | None:
 
 
 def emit(doc: dict, out: str | None) -> None:
-    """Print the benchmark's JSON document on stdout and write it to ``out`` (if given)."""
+    """Print the benchmark's JSON document on stdout and write it to ``out`` (if given), as
+    strict JSON with the commands' conventions (``boundest.commands.jsonable``: infinities as
+    ``"inf"``/``"-inf"``, NaN as ``null``)."""
     import json
     from pathlib import Path
 
-    text = json.dumps(doc, indent=1, default=float)
+    from boundest.commands import jsonable
+
+    text = json.dumps(jsonable(doc), indent=1, allow_nan=False, default=float)
     print(text)
     if out:
         Path(out).write_text(text + "\n")
