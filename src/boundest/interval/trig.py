@@ -306,12 +306,12 @@ def _sincos(a, b, shift):
 
 @gufunc(2)
 def _sin(a, b, lo, hi):
-    lo[0], hi[0] = _sincos(a, b, 0)
+    lo[0], hi[0] = _sincos(a, b, np.int64(0))  # np.int64: _sincos compiled once, not per literal
 
 
 @gufunc(2)
 def _cos(a, b, lo, hi):
-    lo[0], hi[0] = _sincos(a, b, 1)
+    lo[0], hi[0] = _sincos(a, b, np.int64(1))
 
 
 @_jit

@@ -154,9 +154,10 @@ def _ping(sl, sh, alpha, dl, dh, par, tp, ol, oh, scratch):
     # the data's distance is the float64 evaluation of the first-hit formulas: a relative
     # 2^-40 covers its rounding (the reading's box holds that float, not the exact distance)
     bl[3], bh[3] = dl - _D_PAD * abs(dl), dh + _D_PAD * abs(dh)
-    if not raycast_box(bl, bh, par[PASSES], 3, tp[0], tp[1], tp[2], tp[3], tp[4], tp[5], tp[6],
-                       tp[7], tp[8], tp[9], tp[10], tp[11], tp[12], tp[13], tp[14], tp[15],
-                       tp[16], scratch[2], scratch[3], scratch[4]):
+    # np.int64(3), not the literal 3: raycast_box would be compiled a second time for it
+    if not raycast_box(bl, bh, par[PASSES], np.int64(3), tp[0], tp[1], tp[2], tp[3], tp[4],
+                       tp[5], tp[6], tp[7], tp[8], tp[9], tp[10], tp[11], tp[12], tp[13],
+                       tp[14], tp[15], tp[16], scratch[2], scratch[3], scratch[4]):
         return False
     ol[0], oh[0], ol[1], oh[1] = bl[0], bh[0], bl[1], bh[1]
     ol[2] = max(sl[2], _sub_lo(bl[2], bh[2], alpha, alpha))
@@ -183,7 +184,7 @@ def _qinter(FL, FH, first, k, m, q, xl, xh, lows, highs, col_lo, col_hi):
         return True
     dropped = -1
     while True:
-        n = 0
+        n = np.int64(0)  # not the literal 0: covered_hull would be compiled again for it
         for j in range(first, k + 1):  # the pings still in the count
             js = j % m
             hit = True

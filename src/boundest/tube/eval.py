@@ -330,6 +330,10 @@ class CtcEval:
     constraint holds componentwise at the same time ``t``. When the measurement cannot be met,
     ``t``, ``z`` and ``y`` all become empty.
 
+    Only the slices of ``w`` are read: the derivative may jump at every gate (a tube with
+    ``continuous=False``). ``y`` has a derivative, so a tube ``y`` with jumps is made
+    continuous first (:meth:`Tube.make_continuous`).
+
     Parameters
     ----------
     time_deriv : bool
@@ -340,10 +344,6 @@ class CtcEval:
         after the tube is contracted (as Codac's ``CtcEval`` does with ``y.invert(z, w, t)``).
         ``False``: the plain tube inverse ``[y]^{-1}([z])`` (whole slices) and ``[y]([t])``,
         once; cheaper, wider.
-
-    Only the slices of ``w`` are read: the derivative may jump at every gate (a tube with
-    ``continuous=False``). ``y`` has a derivative, so a tube ``y`` with jumps is made
-    continuous first (:meth:`Tube.make_continuous`).
 
     Examples
     --------
