@@ -234,7 +234,7 @@ def polar_box(xl, xh, yl, yh, rl, rh, tl, th):
         return NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN
     # hull of the pieces' solutions: x, y, rho, and theta from the pieces at each end
     hx0, hx1, hy0, hy1, hr0, hr1, ht0, ht1 = INF, -INF, INF, -INF, INF, -INF, INF, -INF
-    low, high = tl >= -BIG, th <= BIG
+    low, high = -BIG <= tl <= BIG, -BIG <= th <= BIG
     j0 = math.floor(tl * _TWO_OVER_PI) - 1 if low else 0
     j1 = math.floor(th * _TWO_OVER_PI) + 1 if high else 0
     few = low and high and j1 - j0 < _MAX_PIECES
