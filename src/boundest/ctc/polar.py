@@ -6,7 +6,8 @@ occurrences of ``rho`` and ``theta``. The method (our derivation; the contractor
 and Jaulin's, as in Codac's ``CtcPolar``) splits ``theta`` at the multiples of ``pi / 2``.
 
 **One quarter turn.** On a piece ``theta in [j pi/2, (j+1) pi/2]`` the rotation by ``-j pi/2``
-(an exact swap and negation of ``x`` and ``y``) brings the points to the first quadrant, with
+(an exact swap and negation of ``x`` and ``y``; for ``j = -1`` the reflection ``y -> -y``, so
+that the angles near 0 keep all their digits) brings the points to the first quadrant, with
 local angle ``psi = theta - j pi/2 in [alpha, beta] ⊂ [0, pi/2]``, box ``[a, b] x [c, d]``
 (clipped to ``x, y >= 0``) and ``rho in [r1, r2]``, ``r1 >= 0``. For a fixed ``psi`` the
 feasible ``rho`` form ``[L, U]`` with ``L = max(r1, a / cos psi, c / sin psi)`` and
@@ -134,12 +135,18 @@ class CtcPolar(Contractor):
 
 
 @_njit
-def _quarter(q, alpha, beta, xl, xh, yl, yh, r1, r2):
+def _quarter(q, alpha, ca_u, sa_d, beta, cb_d, sb_u, xl, xh, yl, yh, r1, r2):
     """Solve the polar constraint on the quarter turn ``q`` (0..3) of the plane, local angle
-    ``psi in [alpha, beta] ⊂ [0, PIO2_HI]``, ``r1 >= 0`` (module docstring). Returns
+    ``psi = theta - q pi/2``, or on the fourth quadrant reflected (``q = -1``,
+    ``psi = -theta``), ``r1 >= 0`` (module docstring). The angles: ``psi in [a_e, b_e]
+    ⊂ [0, pi/2]`` with ``alpha <= a_e``, ``ca_u >= cos a_e``, ``sa_d <= sin a_e`` and
+    ``beta >= b_e``, ``cb_d <= cos b_e``, ``sb_u >= sin b_e``. Returns
     ``(ok, x_lo, x_hi, y_lo, y_hi, rho_lo, rho_hi, psi_lo, psi_hi)`` in global ``x, y``."""
-    # rotate by -q pi/2: local (x', y') = (x, y), (y, -x), (-x, -y), (-y, x)
-    if q == 0:
+    # rotate by -q pi/2: local (x', y') = (x, y), (y, -x), (-x, -y), (-y, x); or reflect
+    # (q = -1): (x, -y)
+    if q == -1:
+        a, b, c, d = xl, xh, -yh, -yl
+    elif q == 0:
         a, b, c, d = xl, xh, yl, yh
     elif q == 1:
         a, b, c, d = yl, yh, -xh, -xl
@@ -151,6 +158,8 @@ def _quarter(q, alpha, beta, xl, xh, yl, yh, r1, r2):
     c = max(c, 0.0) + 0.0
     if not (a <= b and c <= d and alpha <= beta and a <= r2 and c <= r2):
         return False, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN
+    # psi_lo, psi_hi: the end of the angles, or a float bound of the tighter term; the
+    # functions are then evaluated at that float (a bound of psi_lo, psi_hi the right way)
     plo, phi = alpha, beta
     if r1 > 0.0:
         plo = max(plo, _acos_enc(min(1.0, div_up(b, r1)))[0])
@@ -161,10 +170,8 @@ def _quarter(q, alpha, beta, xl, xh, yl, yh, r1, r2):
         phi = min(phi, _acos_enc(div_dn(a, r2))[1], _atan2_up(d, a))
     if not plo <= phi:
         return False, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN
-    cl_u = _cos_enc(plo)[1]  # at psi_lo
-    sl_d = _sin_enc(plo)[0]
-    ch_d = _cos_enc(phi)[0]  # at psi_hi
-    sh_u = _sin_enc(phi)[1]
+    cl_u, sl_d = (ca_u, sa_d) if plo == alpha else (_cos_enc(plo)[1], _sin_enc(plo)[0])
+    ch_d, sh_u = (cb_d, sb_u) if phi == beta else (_cos_enc(phi)[0], _sin_enc(phi)[1])
     # x' bounds
     xlo = max(a, mul_dn(r1, ch_d))
     if c > 0.0:
@@ -198,8 +205,10 @@ def _quarter(q, alpha, beta, xl, xh, yl, yh, r1, r2):
         rhi = min(rhi, div_up(d, sl_d))
     if not (xlo <= xhi and ylo <= yhi and rlo <= rhi) or xlo == INF or ylo == INF:
         return False, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN
-    # rotate back by +q pi/2
-    if q == 0:
+    # rotate (reflect) back
+    if q == -1:
+        gx = (xlo, xhi, -yhi, -ylo)
+    elif q == 0:
         gx = (xlo, xhi, ylo, yhi)
     elif q == 1:
         gx = (-yhi, -ylo, xlo, xhi)
@@ -211,15 +220,73 @@ def _quarter(q, alpha, beta, xl, xh, yl, yh, r1, r2):
 
 
 @_njit
+def _side(t, n):
+    """The sign of ``t - n pi/2`` for a float ``t`` near ``n pi/2``: 1 or -1 when certain
+    (from the sign of ``sin(t - n pi/2)``, libm being accurate to a few ulps), else 0."""
+    if n == 0:
+        return 1 if t > 0.0 else (-1 if t < 0.0 else 0)
+    if abs(t) > BIG:
+        return 0
+    m = n % 4
+    lo, hi = _sin_enc(t) if m % 2 == 0 else _cos_enc(t)
+    if m == 1 or m == 2:
+        lo, hi = -hi, -lo
+    return 1 if lo > 0.0 else (-1 if hi < 0.0 else 0)
+
+
+@_njit
+def _cos_sin(t, q, psi):
+    """``(cos_up, sin_dn, cos_dn, sin_up)`` of the local angle ``psi_e`` of ``theta = t`` in
+    the frame ``q`` (``_quarter``), from libm at ``t`` (or, beyond ``BIG``, at the float
+    ``psi``, a bound of ``psi_e`` on the side where the caller uses it)."""
+    if abs(t) > BIG:
+        cd, cu = _cos_enc(psi)
+        sd, su = _sin_enc(psi)
+        return cu, sd, cd, su
+    cd, cu = _cos_enc(t)
+    sd, su = _sin_enc(t)
+    if q == -1:  # psi = -theta
+        return cu, -su, cd, -sd
+    if q == 1:  # cos psi = sin theta, sin psi = -cos theta
+        return su, -cu, sd, -cd
+    if q == 2:
+        return -cd, -su, -cu, -sd
+    if q == 3:  # cos psi = -sin theta, sin psi = cos theta
+        return -sd, cd, -su, cu
+    return cu, sd, cd, su
+
+
+@_njit
 def _piece(j, tl, th, xl, xh, yl, yh, r1, r2):
     """The quarter turn ``theta in [j pi/2, (j+1) pi/2] ∩ [tl, th]`` (``|j| pi/2 <= BIG``):
-    ``_quarter``'s result with the local angles mapped back to ``theta``."""
+    ``_quarter``'s result with the local angles mapped back to ``theta``. An end of the
+    piece inside ``[tl, th]`` is exact (cos, sin of ``tl`` or ``th`` from libm), an end on
+    the axis too; the float bounds ``alpha``, ``beta`` only serve the comparisons."""
     hd, hu = _halfpi_dn(j), _halfpi_up(j)
-    u = max(tl, hd)
-    v = min(th, _halfpi_up(j + 1))
-    alpha = max(0.0, sub_dn(u, hu))
-    beta = min(PIO2_HI, sub_up(v, hd))
-    ok, x0, x1, y0, y1, r0, rr1, p0, p1 = _quarter(j % 4, alpha, beta, xl, xh, yl, yh, r1, r2)
+    hd1, hu1 = _halfpi_dn(j + 1), _halfpi_up(j + 1)
+    # tl certainly above j pi/2 (then it starts the piece) or certainly above (j+1) pi/2
+    tl_in = tl > hu or (tl >= hd and _side(tl, j) > 0)
+    th_in = th < hd1 or (th <= hu1 and _side(th, j + 1) < 0)
+    if (tl > hu1 or (tl >= hd1 and _side(tl, j + 1) > 0)
+            or th < hd or (th <= hu and _side(th, j) < 0)):
+        return False, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN
+    u, v = max(tl, hd), min(th, hu1)
+    if j == -1:  # psi = -theta, exact: the angles near 0 keep their digits
+        alpha = -th if th_in else 0.0
+        beta = -tl if tl_in else PIO2_HI
+        ca_u, sa_d = _cos_sin(th, -1, alpha)[0:2] if th_in else (1.0, 0.0)
+        cb_d, sb_u = _cos_sin(tl, -1, beta)[2:4] if tl_in else (0.0, 1.0)
+        ok, x0, x1, y0, y1, r0, rr1, p0, p1 = _quarter(-1, alpha, ca_u, sa_d, beta, cb_d, sb_u,
+                                                       xl, xh, yl, yh, r1, r2)
+        t0, t1 = max(u, -p1), min(v, -p0)
+        return ok and t0 <= t1, x0, x1, y0, y1, r0, rr1, t0, t1
+    q = j % 4
+    alpha = max(0.0, sub_dn(tl, hu)) if tl_in else 0.0
+    beta = min(PIO2_HI, sub_up(th, hd)) if th_in else PIO2_HI
+    ca_u, sa_d = _cos_sin(tl, q, alpha)[0:2] if tl_in else (1.0, 0.0)
+    cb_d, sb_u = _cos_sin(th, q, beta)[2:4] if th_in else (0.0, 1.0)
+    ok, x0, x1, y0, y1, r0, rr1, p0, p1 = _quarter(q, alpha, ca_u, sa_d, beta, cb_d, sb_u,
+                                                   xl, xh, yl, yh, r1, r2)
     t0 = max(u, add_dn(p0, hd))
     t1 = min(v, add_up(p1, hu))
     return ok and t0 <= t1, x0, x1, y0, y1, r0, rr1, t0, t1
@@ -249,8 +316,8 @@ def polar_box(xl, xh, yl, yh, rl, rh, tl, th):
             continue
         for j in range(first, last + 1):
             if k == 2:  # a full quadrant: the pieces between the ends
-                ok, x0, x1, y0, y1, r0, r1, t0, t1 = _quarter(j, 0.0, PIO2_HI, xl, xh, yl, yh,
-                                                              rl, rh)
+                ok, x0, x1, y0, y1, r0, r1, t0, t1 = _quarter(j, 0.0, 1.0, 0.0, PIO2_HI, 0.0,
+                                                              1.0, xl, xh, yl, yh, rl, rh)
             else:
                 ok, x0, x1, y0, y1, r0, r1, t0, t1 = _piece(j, tl, th, xl, xh, yl, yh, rl, rh)
             if not ok:
