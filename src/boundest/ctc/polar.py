@@ -85,6 +85,33 @@ _MAX_PIECES = 11
 _END_PIECES = 6
 
 
+# The interval kernels inline these at every call site (Numba IR), which multiplies the
+# compile time of a caller with many calls (45 s cold here): call them through one wrapper each.
+@_njit
+def _cos_w(x):
+    return _cos_enc(x)
+
+
+@_njit
+def _sin_w(x):
+    return _sin_enc(x)
+
+
+@_njit
+def _asin_w(z):
+    return _asin_enc(z)
+
+
+@_njit
+def _atan2_dn_w(y, x):
+    return _atan2_dn(y, x)
+
+
+@_njit
+def _atan2_up_w(y, x):
+    return _atan2_up(y, x)
+
+
 class CtcPolar(Contractor):
     """Minimal contractor of ``x = rho cos(theta), y = rho sin(theta)``.
 
@@ -163,15 +190,15 @@ def _quarter(q, alpha, ca_u, sa_d, beta, cb_d, sb_u, xl, xh, yl, yh, r1, r2):
     plo, phi = alpha, beta
     if r1 > 0.0:
         plo = max(plo, _acos_enc(min(1.0, div_up(b, r1)))[0])
-        phi = min(phi, _asin_enc(min(1.0, div_up(d, r1)))[1])
+        phi = min(phi, _asin_w(min(1.0, div_up(d, r1)))[1])
     if c > 0.0:
-        plo = max(plo, _asin_enc(div_dn(c, r2))[0], _atan2_dn(c, b))
+        plo = max(plo, _asin_w(div_dn(c, r2))[0], _atan2_dn_w(c, b))
     if a > 0.0:
-        phi = min(phi, _acos_enc(div_dn(a, r2))[1], _atan2_up(d, a))
+        phi = min(phi, _acos_enc(div_dn(a, r2))[1], _atan2_up_w(d, a))
     if not plo <= phi:
         return False, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN
-    cl_u, sl_d = (ca_u, sa_d) if plo == alpha else (_cos_enc(plo)[1], _sin_enc(plo)[0])
-    ch_d, sh_u = (cb_d, sb_u) if phi == beta else (_cos_enc(phi)[0], _sin_enc(phi)[1])
+    cl_u, sl_d = (ca_u, sa_d) if plo == alpha else (_cos_w(plo)[1], _sin_w(plo)[0])
+    ch_d, sh_u = (cb_d, sb_u) if phi == beta else (_cos_w(phi)[0], _sin_w(phi)[1])
     # x' bounds
     xlo = max(a, mul_dn(r1, ch_d))
     if c > 0.0:
@@ -228,7 +255,7 @@ def _side(t, n):
     if abs(t) > BIG:
         return 0
     m = n % 4
-    lo, hi = _sin_enc(t) if m % 2 == 0 else _cos_enc(t)
+    lo, hi = _sin_w(t) if m % 2 == 0 else _cos_w(t)
     if m == 1 or m == 2:
         lo, hi = -hi, -lo
     return 1 if lo > 0.0 else (-1 if hi < 0.0 else 0)
@@ -240,11 +267,11 @@ def _cos_sin(t, q, psi):
     the frame ``q`` (``_quarter``), from libm at ``t`` (or, beyond ``BIG``, at the float
     ``psi``, a bound of ``psi_e`` on the side where the caller uses it)."""
     if abs(t) > BIG:
-        cd, cu = _cos_enc(psi)
-        sd, su = _sin_enc(psi)
+        cd, cu = _cos_w(psi)
+        sd, su = _sin_w(psi)
         return cu, sd, cd, su
-    cd, cu = _cos_enc(t)
-    sd, su = _sin_enc(t)
+    cd, cu = _cos_w(t)
+    sd, su = _sin_w(t)
     if q == -1:  # psi = -theta
         return cu, -su, cd, -sd
     if q == 1:  # cos psi = sin theta, sin psi = -cos theta
@@ -271,24 +298,24 @@ def _piece(j, tl, th, xl, xh, yl, yh, r1, r2):
             or th < hd or (th <= hu and _side(th, j) < 0)):
         return False, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN
     u, v = max(tl, hd), min(th, hu1)
+    # the ends (whether inside [tl, th], which theta, their float bound): one call site each
+    # for the compiled helpers (the compile time grows with the inlined code)
     if j == -1:  # psi = -theta, exact: the angles near 0 keep their digits
-        alpha = -th if th_in else 0.0
-        beta = -tl if tl_in else PIO2_HI
-        ca_u, sa_d = _cos_sin(th, -1, alpha)[0:2] if th_in else (1.0, 0.0)
-        cb_d, sb_u = _cos_sin(tl, -1, beta)[2:4] if tl_in else (0.0, 1.0)
-        ok, x0, x1, y0, y1, r0, rr1, p0, p1 = _quarter(-1, alpha, ca_u, sa_d, beta, cb_d, sb_u,
-                                                       xl, xh, yl, yh, r1, r2)
-        t0, t1 = max(u, -p1), min(v, -p0)
-        return ok and t0 <= t1, x0, x1, y0, y1, r0, rr1, t0, t1
-    q = j % 4
-    alpha = max(0.0, sub_dn(tl, hu)) if tl_in else 0.0
-    beta = min(PIO2_HI, sub_up(th, hd)) if th_in else PIO2_HI
-    ca_u, sa_d = _cos_sin(tl, q, alpha)[0:2] if tl_in else (1.0, 0.0)
-    cb_d, sb_u = _cos_sin(th, q, beta)[2:4] if th_in else (0.0, 1.0)
+        q = -1
+        a_in, a_t, alpha = th_in, th, -th if th_in else 0.0
+        b_in, b_t, beta = tl_in, tl, -tl if tl_in else PIO2_HI
+    else:
+        q = j % 4
+        a_in, a_t, alpha = tl_in, tl, max(0.0, sub_dn(tl, hu)) if tl_in else 0.0
+        b_in, b_t, beta = th_in, th, min(PIO2_HI, sub_up(th, hd)) if th_in else PIO2_HI
+    ca_u, sa_d = _cos_sin(a_t, q, alpha)[0:2] if a_in else (1.0, 0.0)
+    cb_d, sb_u = _cos_sin(b_t, q, beta)[2:4] if b_in else (0.0, 1.0)
     ok, x0, x1, y0, y1, r0, rr1, p0, p1 = _quarter(q, alpha, ca_u, sa_d, beta, cb_d, sb_u,
                                                    xl, xh, yl, yh, r1, r2)
-    t0 = max(u, add_dn(p0, hd))
-    t1 = min(v, add_up(p1, hu))
+    if j == -1:
+        t0, t1 = max(u, -p1), min(v, -p0)
+    else:
+        t0, t1 = max(u, add_dn(p0, hd)), min(v, add_up(p1, hu))
     return ok and t0 <= t1, x0, x1, y0, y1, r0, rr1, t0, t1
 
 
@@ -315,11 +342,10 @@ def polar_box(xl, xh, yl, yh, rl, rh, tl, th):
         if k == 0 and not few and not low:
             continue
         for j in range(first, last + 1):
-            if k == 2:  # a full quadrant: the pieces between the ends
-                ok, x0, x1, y0, y1, r0, r1, t0, t1 = _quarter(j, 0.0, 1.0, 0.0, PIO2_HI, 0.0,
-                                                              1.0, xl, xh, yl, yh, rl, rh)
-            else:
-                ok, x0, x1, y0, y1, r0, r1, t0, t1 = _piece(j, tl, th, xl, xh, yl, yh, rl, rh)
+            # k = 2: a full quadrant (the pieces between the ends), its angles unused
+            ok, x0, x1, y0, y1, r0, r1, t0, t1 = _piece(j, -INF if k == 2 else tl,
+                                                        INF if k == 2 else th, xl, xh, yl, yh,
+                                                        rl, rh)
             if not ok:
                 continue
             hx0, hx1, hy0, hy1 = min(hx0, x0), max(hx1, x1), min(hy0, y0), max(hy1, y1)
