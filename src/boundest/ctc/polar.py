@@ -34,8 +34,8 @@ and ``psi_lo``, ``psi_hi`` are rounded outward, so the monotonicity keeps every 
 
 **The whole box.** The solutions are the union over the quarter turns of the pieces' solutions
 and the hull of a union is the hull of the hulls: every piece met by ``theta`` is solved (at
-most 11; for ``theta`` wider than about 2.5 turns, the five lowest and five highest pieces and
-the four full quadrants, which give the same hull). A piece holds the origin when
+most 11; for ``theta`` wider than about 2.5 turns, the seven lowest and seven highest pieces
+and the four full quadrants, which give the same hull). A piece holds the origin when
 ``r1 = a = c = 0``, and then keeps all its angles. Beyond ``|theta| > 2**30`` (where no libm
 accuracy is assumed) an unbounded end of ``theta`` is kept as it is; the other components are
 still contracted as for a full turn. ``rho < 0`` is no solution.
@@ -80,9 +80,11 @@ __all__ = ["CtcPolar", "polar_box"]
 
 _njit = nb.njit(cache=True, error_model="numpy")
 _TWO_OVER_PI = 2.0 / math.pi
-#: more pieces than this: only the lowest and highest ones and the four full quadrants
+#: more pieces than this: only the lowest and highest ones and the four full quadrants. The
+#: estimated first piece ``j0`` is at most two below the true one, so the lowest 7 pieces
+#: hold a full turn (likewise at the top).
 _MAX_PIECES = 11
-_END_PIECES = 6
+_END_PIECES = 7
 
 
 # The interval kernels inline these at every call site (Numba IR), which multiplies the
@@ -356,9 +358,9 @@ def polar_box(xl, xh, yl, yh, rl, rh, tl, th):
                 ht1 = max(ht1, t1)
     if hx0 > hx1:  # no piece has a solution
         return NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN
-    if not few:
-        ht0 = ht0 if low else tl
-        ht1 = ht1 if high else th
+    if not few:  # (an end run without a solution cannot happen; tl, th would be sound)
+        ht0 = ht0 if low and ht0 < INF else tl
+        ht1 = ht1 if high and ht1 > -INF else th
     return (max(xl, hx0), min(xh, hx1), max(yl, hy0), min(yh, hy1), max(rl, hr0),
             min(rh, hr1), max(tl, ht0), min(th, ht1))
 
