@@ -10,7 +10,8 @@ narrower than the other by more than 1e-9 in some component. Codac runs on the f
 ``--codac-boxes`` boxes; its widths are reported side by side with ours on the same boxes,
 with the number of boxes where one is tighter than the other by more than 1e-9 in a component.
 The compile time is that of the first call in a fresh process with an empty
-``NUMBA_CACHE_DIR``, then with that cache filled.
+``NUMBA_CACHE_DIR``, then with that cache filled. ``numpy_floor``: what a vectorised NumPy
+version would cost at least per quarter turn (why the kernel is compiled).
 
 Usage::
 
@@ -34,6 +35,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _machine import cpu_model, emit
 from _subprocess import run_json_script
 
+import boundest.interval as iv
 from boundest import Interval
 from boundest.ctc import CtcFwdBwd, CtcPolar, Fixpoint
 from boundest.expr import Var
@@ -83,6 +85,32 @@ def summary(box: Interval, out: Interval, t: float) -> dict:
     return {"time_s": t, "us_per_box": 1e6 * t / m,
             "mean_width": dict(zip(NAMES, widths(out).mean(axis=0).tolist(), strict=True)),
             "empty": int(np.isnan(out.lo).any(axis=-1).sum())}
+
+
+def numpy_floor(m: int, repeat: int) -> float:
+    """Seconds per box of the public NumPy interval calls that one quarter turn of a
+    vectorised CtcPolar would need at least (6 inverse trig, 4 trig, 24 products and
+    quotients; no masking, no case analysis): the floor of a NumPy implementation."""
+    rng = np.random.default_rng(2)
+    z = Interval(rng.uniform(0, 1, m))
+    a, b = Interval(rng.uniform(0.1, 3, m)), Interval(rng.uniform(0.1, 3, m))
+
+    def quarter() -> None:
+        for f in (iv.acos, iv.asin, iv.asin, iv.acos, iv.cos, iv.sin, iv.cos, iv.sin):
+            f(z)
+        iv.atan2(a, b)
+        iv.atan2(b, a)
+        for _ in range(12):
+            iv.div(a, b)
+            iv.mul(a, b)
+
+    quarter()
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        quarter()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times) / m
 
 
 COMPILE = """
@@ -158,6 +186,7 @@ def main() -> None:
     first = rows[sizes[0]]
     emit({"cpu": cpu_model(), "numpy": np.__version__, "sizes": sizes, "repeat": a.repeat,
           "batches": rows, "codac_1_5_7": codac, "compile": compile_times(),
+          "numpy_floor_us_per_box_per_quarter_turn": 1e6 * numpy_floor(sizes[-1], a.repeat),
           "summary": {"polar_us_per_box": {m: r["ctc_polar"]["us_per_box"]
                                            for m, r in rows.items()},
                       "hc4_us_per_box": {m: r["hc4_fixpoint"]["us_per_box"]

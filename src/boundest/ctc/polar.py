@@ -31,14 +31,18 @@ angle ``atan2(c, a)``, where it is ``|(a, c)|``, and increases away from it, so 
 the three is its least value on the interval; likewise for the far corner). Every function is
 evaluated at its float bounds with the outward-rounded kernels of :mod:`boundest.interval`,
 and ``psi_lo``, ``psi_hi`` are rounded outward, so the monotonicity keeps every bound sound.
+Where ``psi_lo`` or ``psi_hi`` is a bound of ``theta`` itself, cos and sin are those of that
+float ``theta`` (``cos psi = sin theta`` etc.), and near a multiple of ``pi/2`` the sign of
+``sin(theta - j pi/2)`` tells which piece it starts: ``theta = 2*math.pi``, a float just below
+``2 pi``, stays exact.
 
 **The whole box.** The solutions are the union over the quarter turns of the pieces' solutions
 and the hull of a union is the hull of the hulls: every piece met by ``theta`` is solved (at
 most 11; for ``theta`` wider than about 2.5 turns, the seven lowest and seven highest pieces
 and the four full quadrants, which give the same hull). A piece holds the origin when
-``r1 = a = c = 0``, and then keeps all its angles. Beyond ``|theta| > 2**30`` (where no libm
-accuracy is assumed) an unbounded end of ``theta`` is kept as it is; the other components are
-still contracted as for a full turn. ``rho < 0`` is no solution.
+``r1 = a = c = 0``, and then keeps all its angles. An end of ``theta`` beyond ``2**30`` in
+magnitude (infinite included; no libm accuracy is assumed there) is kept as it is, the other
+components are then contracted as for a full turn. ``rho < 0`` is no solution.
 """
 
 from __future__ import annotations
@@ -132,11 +136,13 @@ class CtcPolar(Contractor):
     -----
     "Minimal" (exact): each returned component is the interval hull of that coordinate over the
     solutions in the box, widened only by outward rounding (a few ulps of libm error on the
-    angles). It is a superset of any other sound contraction, e.g. a fixpoint of
-    :class:`CtcFwdBwd` on the same two equations, and usually much tighter. One call is
-    idempotent up to rounding. The contractor is Desrochers and Jaulin's (2016) minimal polar
-    contractor, ``CtcPolar`` in Codac and pyIbex; the method here (quarter turns, monotone
-    bounds) is in the module docstring. One compiled call over the batch, box by box.
+    angles). So it is contained (up to those roundings) in the result of any other sound
+    contraction, e.g. a fixpoint of :class:`CtcFwdBwd` on the same two equations, and strictly
+    narrower where the two occurrences of ``rho`` and of ``theta`` matter (the corners of the
+    box). One call is idempotent up to rounding. The contractor is Desrochers and Jaulin's
+    (2016) minimal polar contractor, ``CtcPolar`` in Codac and pyIbex; the method here
+    (quarter turns, monotone bounds) is in the module docstring. One compiled call over the
+    batch, box by box.
 
     Examples
     --------
