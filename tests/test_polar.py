@@ -22,7 +22,7 @@ from boundest.expr.functions import cos, sin
 DPS = 700
 CTC = CtcPolar()
 INF = math.inf
-SETTINGS = settings(max_examples=200, deadline=None,
+SETTINGS = settings(max_examples=120, deadline=None,
                     suppress_health_check=[HealthCheck.too_slow])
 
 
@@ -214,7 +214,7 @@ def bounded_boxes(draw):
     return np.array(lo), np.array(hi)
 
 
-@settings(max_examples=400, deadline=None)
+@settings(max_examples=300, deadline=None)
 @given(bounded_boxes())
 def test_result_is_the_hull_of_the_solutions(bounds):
     lo, hi = bounds
@@ -242,7 +242,7 @@ def _inflated(b: Interval, rel: float = 1e-12) -> Interval:
     return Interval._new(b.lo - rel * (np.abs(b.lo) + 1.0), b.hi + rel * (np.abs(b.hi) + 1.0))
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=150, deadline=None)
 @given(bounded_boxes())
 def test_never_wider_than_hull_consistency(bounds):
     box = Interval(*bounds)
