@@ -510,29 +510,43 @@ def extract(tape: Tape, lo: NDArray[np.float64], hi: NDArray[np.float64],
 # --- the contractor ------------------------------------------------------------------------
 
 def _incidence(system: LinearSystem):
-    """The row-column incidence matrix (CSR) and its transpose."""
+    """The row-column incidence as CSR index arrays: ``(row_ptr, row_cols, col_ptr,
+    col_rows)``."""
     from scipy.sparse import csr_matrix
 
     inc = csr_matrix((np.ones(system.rows.size), (system.rows, system.cols)),
                      shape=(system.n_rows, system.n_cols))
-    return inc, inc.T.tocsr()
+    inc_t = inc.T.tocsr()
+    return inc.indptr, inc.indices, inc_t.indptr, inc_t.indices
+
+
+def _gather(ptr: NDArray, ind: NDArray, items: NDArray) -> NDArray:
+    """The CSR entries of the rows ``items``, concatenated."""
+    start, lens = ptr[items], ptr[items + 1] - ptr[items]
+    total = int(lens.sum())
+    first = np.cumsum(lens) - lens
+    return ind[np.repeat(start - first, lens) + np.arange(total)]
 
 
 def _local(system: LinearSystem, incidence, j: int, radius: int | None
            ) -> tuple[LinearSystem, NDArray[np.int64]]:
     """The rows within ``radius`` row-steps of column ``j`` (all rows reachable for None),
     on the columns they use: ``(sub-system, its columns' indices in system)``."""
-    inc, inc_t = incidence
+    row_ptr, row_cols, col_ptr, col_rows = incidence
     cols = np.zeros(system.n_cols, dtype=bool)
     cols[j] = True
     rows = np.zeros(system.n_rows, dtype=bool)
+    frontier = np.array([j], dtype=np.int64)
     step = 0
     while radius is None or step < radius:
-        new_rows = (inc_t[cols].sum(axis=0).A1 > 0) & ~rows  # rows touching the columns
-        if not new_rows.any():
+        new_rows = _gather(col_ptr, col_rows, frontier)  # rows touching the new columns
+        new_rows = np.unique(new_rows[~rows[new_rows]])
+        if not new_rows.size:
             break
-        rows |= new_rows
-        cols |= inc[new_rows].sum(axis=0).A1 > 0
+        rows[new_rows] = True
+        new_cols = _gather(row_ptr, row_cols, new_rows)
+        frontier = np.unique(new_cols[~cols[new_cols]])
+        cols[frontier] = True
         step += 1
     sub = system.select(rows)
     used = np.nonzero(cols)[0]

@@ -3,8 +3,8 @@
 Trombettoni, Araya, Neveu and Chabert 2011 (X-Newton, the polytope hull contractor of IBEX):
 around the current box, every nonlinear primitive ``z = op(x[, y])`` is enclosed by a few
 linear inequalities valid on the whole box, and the LP over them and the exactly linear rows
-(``boundest.ctc.linear``) contracts the box. Smaller boxes give tighter inequalities, so the contraction is iterated
-(``CtcPolytopeHull``).
+(``boundest.ctc.linear``) contracts the box. Smaller boxes give tighter inequalities, so the
+contraction is iterated (``CtcPolytopeHull``).
 
 Rows are ``sum_t a_t v_t <= r`` with **exact float coefficients** ``a_t`` and a right-hand
 side ``r`` rounded outward: every point of the node's graph over the box satisfies the row
