@@ -22,6 +22,7 @@ from hypothesis import strategies as st
 pytest.importorskip("scipy")
 
 from boundest.csp import LinearRelaxation, propagate
+from boundest.csp.linear import propagate_lp
 from boundest.ctc import CtcLinear, CtcPolytopeHull
 from boundest.ctc.linear import extract, lp_bound
 from boundest.ctc.relax import relaxation
@@ -243,6 +244,22 @@ def test_relaxation_beats_hull_consistency_on_the_dependency_problem():
     tape = compile_model(m)
     box = CtcPolytopeHull(tape, rounds=10)(hc.slots)[tape.slot_of["x"]]
     assert box.contains(0.0) and box.contains(1.5) and float(box.hi - box.lo) < 1.5 + 1e-3
+
+
+def test_relax_option_of_ctc_linear_and_propagate_lp():
+    m = _model_x_y([x * x - 2 * x + y == 0, y == 0.5 * x])
+    tape = compile_model(m)
+    hc = propagate(tape)
+    sx = tape.slot_of["x"]
+    one = CtcLinear(tape, relax=True)(hc.slots)[sx]
+    assert one.contains(0.0) and one.contains(1.5) and float(one.hi - one.lo) < 6.0
+    assert float(CtcLinear(tape)(hc.slots)[sx].hi - CtcLinear(tape)(hc.slots)[sx].lo) == 6.0
+    r = propagate_lp(tape, relax=True, rounds=10)
+    assert r.consistent and r["x"].contains(0.0) and r["x"].contains(1.5)
+    assert float(r["x"].hi - r["x"].lo) < 1.6
+    ext = extract(tape, hc.slots.lo, hc.slots.hi, relax=True)
+    ineq = ext.system.b_lo == -np.inf
+    assert ineq.any() and np.all(np.isfinite(ext.system.b_hi))
 
 
 def test_relaxation_narrows_products_more_than_hull_consistency():

@@ -187,7 +187,8 @@ def _convex(z: NDArray, x: NDArray, xl: NDArray, xh: NDArray, curv: NDArray,
     d = np.maximum((gl - S * L).hi, (gh - S * H).hi)
     out.append(_block([z, x], [cv, -s], d, ok & fin))
     # tangents at the ends and the midpoint: s x - cv z <= -e
-    mid = np.where(fin, 0.5 * xl + 0.5 * xh, np.nan)
+    with np.errstate(invalid="ignore"):  # (the rows of unbounded boxes are dropped)
+        mid = np.where(fin, np.clip(0.5 * xl + 0.5 * xh, xl, xh), np.nan)
     for p in (xl, mid, xh):
         P = _pt(p)
         D = dg(P)
