@@ -17,7 +17,8 @@ mode. Codac 1.5.7's widths and times are quoted from ``benchmarks/results/satell
 (measured there on the same data, hull consistency); the EKF/RTS widths and the lower bound of
 the exact hull are quoted from the project's issue tracker (issue 13), not measured here.
 
-Usage (the whole run is about 6 min; ``--update`` merges a part into the JSON, so it can be
+Usage (the whole run is about 6 min without the relax rows, which add about 2 min at k_max = 200
+and 2 min per seed of ``--lp-seeds``; ``--update`` merges a part into the JSON, so it can be
 run in parts: by horizon with ``--k-max``, by mode with ``--only``, a regular expression on the
 labels)::
 

@@ -29,6 +29,7 @@ from boundest.ctc.relax import relaxation
 from boundest.expr import Model, Op, Var
 from boundest.expr import functions as fn
 from boundest.expr.tape import compile_model
+from boundest.interval import Interval
 
 from .exact_lp import exact_min
 from .strategies import solvable_csps
@@ -260,6 +261,22 @@ def test_relax_option_of_ctc_linear_and_propagate_lp():
     ext = extract(tape, hc.slots.lo, hc.slots.hi, relax=True)
     ineq = ext.system.b_lo == -np.inf
     assert ineq.any() and np.all(np.isfinite(ext.system.b_hi))
+
+
+def test_polytope_hull_on_a_batch_and_on_an_empty_csp():
+    m = _model_x_y([x * x - 2 * x + y == 0, y == 0.5 * x])
+    tape = compile_model(m)
+    box = propagate(tape).slots
+    ctc = CtcPolytopeHull(tape, rounds=2)
+    batch = ctc(Interval._new(np.stack([box.lo, box.lo]), np.stack([box.hi, box.hi])))
+    one = ctc(box)
+    assert batch.shape == (2, tape.n_slots)
+    assert np.array_equal(batch.lo[1], one.lo) and np.array_equal(batch.hi[0], one.hi)
+    m = _model_x_y([x + y == 1.5, x * x + y * y <= 0.9], (-2.0, 2.0))
+    tape = compile_model(m)
+    assert bool(CtcPolytopeHull(tape, rounds=10)(propagate(tape).slots).is_empty().all())
+    with pytest.raises(ValueError, match="rounds"):
+        CtcPolytopeHull(tape, rounds=0)
 
 
 def test_relaxation_narrows_products_more_than_hull_consistency():
