@@ -5,7 +5,9 @@ Modes: ``hc4`` (hull consistency, the fixed point of ``benchmarks/bench_satellit
 with the default settings (``satellite.SHAVING``, what ``boundest run satellite`` uses) and a few
 others (cheaper, tighter), ``bc`` (box consistency of the states, ``mode="bc"``), ``bc+3b``, and
 ``lp`` (LP contraction of the linear rows at the fixed point, ``mode="lp"``, side by side with
-``csp.linear.propagate_lp``, which restarts hull consistency after each LP), on the embedded data
+``csp.linear.propagate_lp``, which restarts hull consistency after each LP), ``lp + relax`` (the
+LPs also over the linear relaxation of the nonlinear nodes around the box,
+``LinearRelaxation(relax=True)``) and ``3b`` then ``lp + relax`` from its box, on the embedded data
 at k_max = 200 (``satellite_k200.csv``) and 800
 (``satellite_k800.csv``). Per mode and data set: the median propagation time over ``--repeat``
 runs after a warm-up, the mean width of each state component over k = 0..k_max, the widest x1
@@ -15,7 +17,8 @@ mode. Codac 1.5.7's widths and times are quoted from ``benchmarks/results/satell
 (measured there on the same data, hull consistency); the EKF/RTS widths and the lower bound of
 the exact hull are quoted from the project's issue tracker (issue 13), not measured here.
 
-Usage (the whole run is about 6 min; ``--update`` merges a part into the JSON, so it can be
+Usage (the whole run is about 6 min without the relax rows, which add about 2 min at k_max = 200
+and 2 min per seed of ``--lp-seeds``; ``--update`` merges a part into the JSON, so it can be
 run in parts: by horizon with ``--k-max``, by mode with ``--only``, a regular expression on the
 labels)::
 
@@ -32,7 +35,7 @@ import re
 import statistics
 import sys
 import time
-from dataclasses import asdict
+from dataclasses import asdict, replace
 from pathlib import Path
 
 import numpy as np
@@ -75,11 +78,19 @@ def _modes():
              {"boxcons": BoxConsistency(), "shaving": sat.SHAVING}),
             ("lp (radius=12, linear rows, 3 rounds)", "lp",
              {"linear": LinearRelaxation(**LP)}),
-            ("propagate_lp (radius=12, linear rows, 3 rounds)", "propagate_lp", {})]
+            ("propagate_lp (radius=12, linear rows, 3 rounds)", "propagate_lp", {}),
+            ("lp + relax (radius=6, linear + relaxed rows, 1 round)", "lp",
+             {"linear": LinearRelaxation(radius=6, log_linear=False, rounds=1, relax=True)}),
+            ("lp + relax (radius=12, linear + relaxed rows, 1 round)", "lp",
+             {"linear": LinearRelaxation(**LP, rounds=1, relax=True)}),
+            ("lp + relax (radius=12, linear + relaxed rows, 3 rounds)", "lp",
+             {"linear": LinearRelaxation(**LP, relax=True)}),
+            ("3b default, then lp + relax (radius=12, 1 round)", "3b+lp",
+             {"shaving": sat.SHAVING, "linear": LinearRelaxation(**LP, rounds=1, relax=True)})]
 
 
 def _lp_like(mode: str) -> bool:
-    return mode in ("lp", "propagate_lp")
+    return mode in ("lp", "propagate_lp", "3b+lp")
 
 
 def _once(tape, names, mode, kw):
@@ -92,6 +103,14 @@ def _once(tape, names, mode, kw):
         return r, r.time_s, {"rounds": r.rounds, "lp_time_s": r.lp_time_s,
                              "hc_time_s": r.hc_time_s, "widths": r.widths,
                              "evaluations": None}
+    if mode == "3b+lp":  # shaving's box, then LP contraction (and propagation) from it
+        t0 = time.perf_counter()
+        s = propagate(tape, mode="3b", shave=names, progress=False, shaving=kw["shaving"])
+        r = propagate(replace(tape, lo=s.slots.lo, hi=s.slots.hi), mode="lp", targets=names,
+                      progress=False, linear=kw["linear"])
+        info = {"evaluations": s.evaluations + r.evaluations, "shaving": s.shaving,
+                "linear": r.linear, "shave_time_s": s.time_s}
+        return r, time.perf_counter() - t0, info
     r = propagate(tape, mode=mode, shave=names, targets=names, progress=False, **kw)
     info = {"evaluations": r.evaluations, "shaving": r.shaving, "boxcons": r.boxcons,
             "linear": r.linear}

@@ -68,7 +68,7 @@ class LPPropagation:
 
 def propagate_lp(model: Model | list[Constraint] | Tape, *, targets: list[str] | None = None,
                  rounds: int = 3, min_gain: float = 0.01, radius: int | None = None,
-                 log_linear: bool = True, **kwargs) -> LPPropagation:
+                 log_linear: bool = True, relax: bool = False, **kwargs) -> LPPropagation:
     """Hull consistency, then LP contraction and hull consistency again, up to ``rounds``
     times.
 
@@ -87,6 +87,9 @@ def propagate_lp(model: Model | list[Constraint] | Tape, *, targets: list[str] |
         ``CtcLinear``); default: the whole connected sub-network.
     log_linear : bool
         Use the log-linear rows of multiplicative constraints (Jaulin 2002 eq. 19).
+    relax : bool
+        Also use a linear relaxation of the nonlinear nodes around the box of each round
+        (``ctc.relax.relaxation``).
     **kwargs
         Passed to ``propagate`` (``rel_eps``, ``max_evaluations``, ``window``, ...).
     """
@@ -105,7 +108,7 @@ def propagate_lp(model: Model | list[Constraint] | Tape, *, targets: list[str] |
     while prop.consistent and done < rounds:
         t0 = time.perf_counter()
         lo, hi, ok = contract_slots(tape, prop.slots.lo, prop.slots.hi, slots, log_linear,
-                                    radius)
+                                    radius, relax)
         lp += time.perf_counter() - t0
         done += 1
         if not ok:

@@ -136,12 +136,18 @@ class LinearRelaxation:
         connected sub-network).
     log_linear : bool
         Also use the log-linear rows of multiplicative constraints (Jaulin 2002 eq. 19).
+    relax : bool
+        Also use a linear relaxation of the nonlinear nodes around the current box
+        (``ctc.relax.relaxation``: McCormick rows of products and quotients, secants and
+        tangents of convex or concave unary functions; the polytope hull of Trombettoni et
+        al. 2011). Each round relaxes around the box the previous rounds reached.
     """
 
     rounds: int = 3
     min_gain: float = 0.01
     radius: int | None = None
     log_linear: bool = True
+    relax: bool = False
 
     def __post_init__(self) -> None:
         if self.rounds < 1:
@@ -286,7 +292,8 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
     per variable does not grow with the CSP. ``mode="bc+3b"`` runs box consistency, then
     shaving. ``mode="lp"`` contracts the linear and log-linear sub-networks by LPs at hull
     consistency's fixed point (``ctc.linear.contract_slots``, needs SciPy: ``pip install
-    'boundest[lp]'``) and propagates only what they narrowed (the users of the narrowed slots
+    'boundest[lp]'``; with ``linear.relax``, also over a linear relaxation of the nonlinear
+    nodes around the box) and propagates only what they narrowed (the users of the narrowed slots
     become dirty), up to ``linear.rounds`` times while it pays; unlike ``csp.linear.
     propagate_lp`` it never restarts propagation from scratch. The LPs are global: their cost
     grows faster than the CSP.
@@ -456,7 +463,8 @@ def _lp_rounds(tape: Tape, lo: np.ndarray, hi: np.ndarray, ptr: np.ndarray, adj:
     stats = np.zeros(1, dtype=np.int64)
     while done < opts.rounds:
         t1 = time.perf_counter()
-        nlo, nhi, ok = contract_slots(tape, lo, hi, slots, opts.log_linear, opts.radius)
+        nlo, nhi, ok = contract_slots(tape, lo, hi, slots, opts.log_linear, opts.radius,
+                                      opts.relax)
         lp_time += time.perf_counter() - t1
         done += 1
         if not ok:
@@ -478,7 +486,8 @@ def _lp_rounds(tape: Tape, lo: np.ndarray, hi: np.ndarray, ptr: np.ndarray, adj:
             break
     info = {"rounds": done, "lp_time_s": lp_time, "evaluations": evals, "widths": widths,
             "settings": {"rounds": opts.rounds, "min_gain": opts.min_gain,
-                         "radius": opts.radius, "log_linear": opts.log_linear},
+                         "radius": opts.radius, "log_linear": opts.log_linear,
+                         "relax": opts.relax},
             "time_s": time.perf_counter() - t0}
     return status, info
 

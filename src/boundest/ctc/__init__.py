@@ -1,7 +1,7 @@
 """Contractors: forward-backward on a tape, composition, fixpoint, inflation, q-relaxed
-intersection, 3B shaving; LP contraction of linear / log-linear sub-networks; the minimal polar
-contractor (range and bearing); the range sensor (first-hit distance along a ray of an obstacle
-map)."""
+intersection, 3B shaving; LP contraction of linear / log-linear sub-networks and of a linear
+relaxation of the nonlinear ones (polytope hull); the minimal polar contractor (range and
+bearing); the range sensor (first-hit distance along a ray of an obstacle map)."""
 
 from .base import Contractor, Fixpoint, FunctionContractor, Inflate, Sequence, Union, shrink_ratio
 from .fwdbwd import CtcFwdBwd
@@ -10,8 +10,9 @@ from .obstacles import ObstacleMap
 from .polar import CtcPolar
 from .qinter import CtcQInter
 from .raycast import CtcRayCast
+from .relax import CtcPolytopeHull
 from .shave import CtcShave
 
-__all__ = ["Contractor", "CtcFwdBwd", "CtcLinear", "CtcPolar", "CtcQInter", "CtcRayCast",
-           "CtcShave", "Fixpoint", "FunctionContractor", "Inflate", "ObstacleMap", "Sequence",
-           "Union", "shrink_ratio"]
+__all__ = ["Contractor", "CtcFwdBwd", "CtcLinear", "CtcPolar", "CtcPolytopeHull", "CtcQInter",
+           "CtcRayCast", "CtcShave", "Fixpoint", "FunctionContractor", "Inflate", "ObstacleMap",
+           "Sequence", "Union", "shrink_ratio"]

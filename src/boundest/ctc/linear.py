@@ -24,7 +24,7 @@ positive (a Farkas certificate checked in interval arithmetic).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
@@ -148,8 +148,9 @@ def safe_lower_bound(system: LinearSystem, c: NDArray[np.float64], y: NDArray[np
 
     ``c^T x = y^T (A x) + r^T x`` with ``[r] = c - [A]^T y``; with ``A x in [b]`` and
     ``x in [lo, hi]`` the bound is the lower end of ``y^T [b] + [r]^T [lo, hi]``, in interval
-    arithmetic (a product ``0 * inf`` is 0; a bound of a row or a column that is infinite on
-    the side its multiplier needs makes the result ``-inf``). NaN multipliers count as 0.
+    arithmetic (a product ``0 * inf`` is 0; a bound of a column that is infinite on the side
+    its reduced cost needs makes the result ``-inf``). NaN multipliers count as 0, and so do
+    multipliers of the sign that needs a row's infinite bound.
 
     Parameters
     ----------
@@ -162,6 +163,10 @@ def safe_lower_bound(system: LinearSystem, c: NDArray[np.float64], y: NDArray[np
         The box of the variables.
     """
     y = np.where(np.isfinite(y), y, 0.0)
+    # a multiplier of the wrong sign on a one-sided row (solver noise) would make the bound
+    # -inf; 0 is as valid a multiplier as any
+    y = np.where(system.b_lo == -np.inf, np.minimum(y, 0.0), y)
+    y = np.where(system.b_hi == np.inf, np.maximum(y, 0.0), y)
     r = Interval(np.asarray(c, dtype=np.float64)) - _column_sums(system, y)
     terms_x = r * Interval._new(lo, hi)
     terms_b = Interval(y) * Interval._new(system.b_lo, system.b_hi)
@@ -234,7 +239,9 @@ class _Solver:
         lp.a_matrix_.start_ = csc.indptr.astype(np.int32)
         lp.a_matrix_.index_ = csc.indices.astype(np.int32)
         lp.a_matrix_.value_ = csc.data.astype(np.float64)
-        if h.passModel(lp) != hc.HighsStatus.kOk:  # pragma: no cover - malformed model
+        # (a warning: HiGHS dropped tiny coefficients; the bounds stay rigorous, since
+        # safe_lower_bound uses the system's own coefficients)
+        if h.passModel(lp) == hc.HighsStatus.kError:  # pragma: no cover - malformed model
             raise RuntimeError("HiGHS rejected the LP")
         self.highs = h
         self.idx = np.arange(system.n_cols, dtype=np.int32)
@@ -339,11 +346,16 @@ class _Rows:
     lo: list
     hi: list
     n: int = 0
+    b: list = field(default_factory=list)  # (first row, b_hi) of inequality blocks
 
-    def add(self, cols: list[NDArray], coef_lo: list[NDArray], coef_hi: list[NDArray]) -> None:
-        """One row per element of the (equal-length) column arrays, ``sum coef * col = 0``."""
+    def add(self, cols: list[NDArray], coef_lo: list[NDArray], coef_hi: list[NDArray],
+            b_hi: NDArray | None = None) -> None:
+        """One row per element of the (equal-length) column arrays, ``sum coef * col = 0``
+        (with ``b_hi``: ``sum coef * col <= b_hi``)."""
         m = len(cols[0])
         rows = self.n + np.arange(m)
+        if b_hi is not None:
+            self.b.append((self.n, np.asarray(b_hi, dtype=np.float64)))
         for col, a, b in zip(cols, coef_lo, coef_hi, strict=True):
             self.r.append(rows)
             self.c.append(np.asarray(col, dtype=np.int64))
@@ -371,8 +383,11 @@ class _Rows:
             part = acc[inv[sel]] + Interval._new(lo[sel], hi[sel])
             acc.lo[inv[sel]], acc.hi[inv[sel]] = part.lo, part.hi
         acc_lo, acc_hi = acc.lo, acc.hi
-        z = np.zeros(self.n)
-        return LinearSystem(uniq // n_cols, uniq % n_cols, acc_lo, acc_hi, z, z.copy(), n_cols)
+        b_lo, b_hi = np.zeros(self.n), np.zeros(self.n)
+        for first, rhs in self.b:
+            b_lo[first:first + rhs.size] = -np.inf
+            b_hi[first:first + rhs.size] = rhs
+        return LinearSystem(uniq // n_cols, uniq % n_cols, acc_lo, acc_hi, b_lo, b_hi, n_cols)
 
 
 def _log_abs(lo: NDArray, hi: NDArray) -> tuple[NDArray, NDArray]:
@@ -402,15 +417,19 @@ class Extraction:
 
 
 def extract(tape: Tape, lo: NDArray[np.float64], hi: NDArray[np.float64],
-            log_linear: bool = True) -> Extraction:
-    """The linear rows of ``tape`` and (``log_linear``) the log-linear rows valid at ``[lo, hi]``.
+            log_linear: bool = True, relax: bool = False) -> Extraction:
+    """The linear rows of ``tape``, (``log_linear``) the log-linear rows valid at ``[lo, hi]``
+    and (``relax``) a linear relaxation of its nonlinear nodes over ``[lo, hi]``.
 
     Linear rows: ``add``, ``sub``, ``neg``, and ``mul``/``div`` where one factor (the divisor
     for ``div``) is a constant slot or has a degenerate domain, which becomes an interval
     coefficient. Log-linear rows (Jaulin 2002 equations 17-19), for nodes all of whose slots
     are sign-definite (domain in ``]0, inf[`` or ``]-inf, 0[``) at the box: ``mul``, ``div``,
     ``sqr``, ``pown``, ``neg``, ``abs``, ``sqrt`` and ``pow`` with a degenerate exponent, in
-    ``X = log|x|``; ``exp`` and ``log`` link a slot to the logarithm of another.
+    ``X = log|x|``; ``exp`` and ``log`` link a slot to the logarithm of another. Relaxed rows
+    (``ctc.relax.relaxation``: McCormick rows of products and quotients, secants and tangents
+    of the unary functions where their convexity is proven on the box) are inequalities over
+    the slots, for the nodes that have no exact linear row.
     """
     n = tape.n_slots
     op, out, a, b = tape.op, tape.out.astype(np.int64), tape.a.astype(np.int64), \
@@ -435,6 +454,12 @@ def extract(tape: Tape, lo: NDArray[np.float64], hi: NDArray[np.float64],
         rows.add([out[m], var[m]], [one, -hi[cst[m]]], [one, -lo[cst[m]]])
     m = code("div") & point[bb] & ((lo[bb] > 0) | (hi[bb] < 0))  # c out - x = 0
     rows.add([out[m], a[m]], [lo[bb[m]], -one], [hi[bb[m]], -one])
+    if relax:
+        from .relax import relaxation  # (relax imports this module)
+
+        exact = (code("mul") & (point[a] | point[bb])) | m
+        for blk in relaxation(tape, lo, hi, skip=exact):
+            rows.add(blk.cols, blk.coefs, blk.coefs, blk.rhs)
     if not log_linear:
         return Extraction(rows.system(n), n, np.zeros(0, dtype=np.int64))
 
@@ -485,29 +510,43 @@ def extract(tape: Tape, lo: NDArray[np.float64], hi: NDArray[np.float64],
 # --- the contractor ------------------------------------------------------------------------
 
 def _incidence(system: LinearSystem):
-    """The row-column incidence matrix (CSR) and its transpose."""
+    """The row-column incidence as CSR index arrays: ``(row_ptr, row_cols, col_ptr,
+    col_rows)``."""
     from scipy.sparse import csr_matrix
 
     inc = csr_matrix((np.ones(system.rows.size), (system.rows, system.cols)),
                      shape=(system.n_rows, system.n_cols))
-    return inc, inc.T.tocsr()
+    inc_t = inc.T.tocsr()
+    return inc.indptr, inc.indices, inc_t.indptr, inc_t.indices
+
+
+def _gather(ptr: NDArray, ind: NDArray, items: NDArray) -> NDArray:
+    """The CSR entries of the rows ``items``, concatenated."""
+    start, lens = ptr[items], ptr[items + 1] - ptr[items]
+    total = int(lens.sum())
+    first = np.cumsum(lens) - lens
+    return ind[np.repeat(start - first, lens) + np.arange(total)]
 
 
 def _local(system: LinearSystem, incidence, j: int, radius: int | None
            ) -> tuple[LinearSystem, NDArray[np.int64]]:
     """The rows within ``radius`` row-steps of column ``j`` (all rows reachable for None),
     on the columns they use: ``(sub-system, its columns' indices in system)``."""
-    inc, inc_t = incidence
+    row_ptr, row_cols, col_ptr, col_rows = incidence
     cols = np.zeros(system.n_cols, dtype=bool)
     cols[j] = True
     rows = np.zeros(system.n_rows, dtype=bool)
+    frontier = np.array([j], dtype=np.int64)
     step = 0
     while radius is None or step < radius:
-        new_rows = (inc_t[cols].sum(axis=0).A1 > 0) & ~rows  # rows touching the columns
-        if not new_rows.any():
+        new_rows = _gather(col_ptr, col_rows, frontier)  # rows touching the new columns
+        new_rows = np.unique(new_rows[~rows[new_rows]])
+        if not new_rows.size:
             break
-        rows |= new_rows
-        cols |= inc[new_rows].sum(axis=0).A1 > 0
+        rows[new_rows] = True
+        new_cols = _gather(row_ptr, row_cols, new_rows)
+        frontier = np.unique(new_cols[~cols[new_cols]])
+        cols[frontier] = True
         step += 1
     sub = system.select(rows)
     used = np.nonzero(cols)[0]
@@ -573,6 +612,9 @@ class CtcLinear(Contractor):
     radius : int, optional
         Solve each target's LPs on the rows within this many row-steps of it (default: the
         whole connected sub-network).
+    relax : bool
+        Also use a linear relaxation of the nonlinear nodes around the box
+        (``ctc.relax.relaxation``; ``CtcPolytopeHull`` repeats it as the box shrinks).
 
     Notes
     -----
@@ -581,13 +623,15 @@ class CtcLinear(Contractor):
     """
 
     def __init__(self, tape: Tape, targets: NDArray[np.int64] | None = None,
-                 log_linear: bool = True, radius: int | None = None) -> None:
+                 log_linear: bool = True, radius: int | None = None,
+                 relax: bool = False) -> None:
         _linprog()  # fail at construction, naming the extra, when SciPy is missing
         self.tape = tape
         self.n = tape.n_slots
         self.targets = None if targets is None else np.asarray(targets, dtype=np.int64)
         self.log_linear = log_linear
         self.radius = radius
+        self.relax = relax
 
     def contract(self, x: Interval) -> Interval:
         if x.ndim > 1:
@@ -596,7 +640,7 @@ class CtcLinear(Contractor):
             return Interval._new(np.stack([p.lo for p in parts]).reshape(x.shape),
                                  np.stack([p.hi for p in parts]).reshape(x.shape))
         lo, hi, ok = contract_slots(self.tape, x.lo, x.hi, self.targets, self.log_linear,
-                                    self.radius)
+                                    self.radius, self.relax)
         if not ok:
             return Interval.empty(x.shape)
         return Interval._new(lo, hi)
@@ -604,13 +648,13 @@ class CtcLinear(Contractor):
 
 def contract_slots(tape: Tape, lo: NDArray[np.float64], hi: NDArray[np.float64],
                    targets: NDArray[np.int64] | None = None, log_linear: bool = True,
-                   radius: int | None = None
+                   radius: int | None = None, relax: bool = False
                    ) -> tuple[NDArray[np.float64], NDArray[np.float64], bool]:
     """``CtcLinear`` on the slot arrays of a tape: ``(lo, hi, feasible)`` (see there)."""
     lo, hi = np.asarray(lo, dtype=np.float64).copy(), np.asarray(hi, dtype=np.float64).copy()
     if np.isnan(lo).any() or (lo > hi).any():
         return lo, hi, False
-    ext = extract(tape, lo, hi, log_linear)
+    ext = extract(tape, lo, hi, log_linear, relax)
     if ext.system.n_rows == 0:
         return lo, hi, True
     clo, chi = ext.column_bounds(lo, hi)
