@@ -101,10 +101,10 @@ def host_supports_target() -> bool:
     return all(features.get(f, False) for f in V3_FEATURES)
 
 
-def read_manifest(path: Path = MANIFEST) -> dict | None:
-    """The manifest as a dict, or None when it is missing or malformed."""
+def read_manifest(path: Path | None = None) -> dict | None:
+    """The manifest (default: the shipped one) as a dict, or None when missing or malformed."""
     try:
-        doc = json.loads(Path(path).read_text(encoding="utf-8"))
+        doc = json.loads(Path(path or MANIFEST).read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return None
     need = ("numba", "llvmlite", "numpy", "python", "triple", "cpu_name", "cpu_features",
@@ -360,8 +360,9 @@ def _build_all_ufuncs() -> int:
     return 0
 
 
-def build(timeout: float = 1800.0) -> int:
-    """Compile every command's kernels into a new cache and write the archive and manifest."""
+def build(names: list[str] | None = None, timeout: float = 1800.0) -> int:
+    """Compile every command's kernels (or those of ``names``, for a quick try) into a new
+    cache and write the archive and manifest."""
     import time
 
     digest = numba_sources_digest()
@@ -371,7 +372,7 @@ def build(timeout: float = 1800.0) -> int:
         env = dict(os.environ, NUMBA_CACHE_DIR=str(cache), NUMBA_CPU_NAME=TARGET_CPU,
                    NUMBA_CPU_FEATURES=TARGET_FEATURES, MPLBACKEND="Agg")
         env[ENV_SWITCH] = "0"
-        for name in [*COMMANDS, "_ufuncs"]:
+        for name in [*(names or COMMANDS), "_ufuncs"]:
             argv = ["_ufuncs"] if name == "_ufuncs" else _command_argv(name, Path(tmp) / "out")
             r = _run_logged(argv, env, Path(tmp) / "log.json", timeout)
             n = len(r["compiled"] or [])
@@ -403,17 +404,18 @@ def build(timeout: float = 1800.0) -> int:
                 info.size, info.mtime, info.mode = len(data), 0, 0o644
                 tar.addfile(info, io.BytesIO(data))
         raw = sum(f.stat().st_size for f in files.values())
-        ARCHIVE.write_bytes(tmp_archive.read_bytes())
-    versions = running_versions()
-    manifest = {
-        **versions, "cpu_name": TARGET_CPU, "cpu_features": TARGET_FEATURES,
-        "sources_sha256": digest, "archive_sha256": hashlib.sha256(ARCHIVE.read_bytes())
-        .hexdigest(), "archive_bytes": ARCHIVE.stat().st_size, "unpacked_bytes": raw,
-        "commands": list(COMMANDS), "files": list(files), "sources": sources}
-    MANIFEST.write_text(json.dumps(manifest, indent=1) + "\n", encoding="utf-8")
+        packed = tmp_archive.read_bytes()
     if numba_sources_digest() != digest:
-        print("build: the Numba sources changed while building: build again", file=sys.stderr)
+        print("build: the Numba sources changed while building (nothing written): build "
+              "again", file=sys.stderr)
         return 1
+    manifest = {
+        **running_versions(), "cpu_name": TARGET_CPU, "cpu_features": TARGET_FEATURES,
+        "sources_sha256": digest, "archive_sha256": hashlib.sha256(packed).hexdigest(),
+        "archive_bytes": len(packed), "unpacked_bytes": raw,
+        "commands": list(names or COMMANDS), "files": list(files), "sources": sources}
+    _write_atomic(ARCHIVE, packed)
+    _write_atomic(MANIFEST, (json.dumps(manifest, indent=1) + "\n").encode())
     print(f"build: {len(files)} files, {raw / 1e6:.1f} MB -> {ARCHIVE} "
           f"{ARCHIVE.stat().st_size / 1e6:.1f} MB in {time.perf_counter() - t_start:.0f} s",
           file=sys.stderr)
@@ -435,14 +437,15 @@ def _module_of(filename: str, modules: set[str]) -> str | None:
     return None
 
 
-def verify(timeout: float = 900.0) -> int:
-    """Run every command with a fresh cache from the archive; fail if anything compiles."""
+def verify(names: list[str] | None = None, timeout: float = 900.0) -> int:
+    """Run every command (or ``names``) with a fresh cache from the archive; fail if anything
+    compiles."""
     bad = 0
     with tempfile.TemporaryDirectory(prefix="boundest-kernels-verify-") as tmp:
         env = dict(os.environ, NUMBA_CACHE_DIR=str(Path(tmp) / "cache"), MPLBACKEND="Agg")
         for var in (ENV_SWITCH, "NUMBA_CPU_NAME", "NUMBA_CPU_FEATURES"):
             env.pop(var, None)
-        for name in COMMANDS:
+        for name in names or COMMANDS:
             r = _run_logged(_command_argv(name, Path(tmp) / "out"), env,
                             Path(tmp) / "log.json", timeout)
             ok = r["rc"] in (0, 1) and r["compiled"] == [] and r["status"] in ("installed",
@@ -466,10 +469,13 @@ def main(argv: list[str] | None = None) -> int:
     if argv and argv[0] == "_run":
         return _logged_main(argv[1:])
     cmds = {"build": build, "verify": verify, "check": check}
-    if len(argv) != 1 or argv[0] not in cmds:
-        print("usage: python -m boundest._kernels build | verify | check", file=sys.stderr)
+    names = argv[1:]
+    if not argv or argv[0] not in cmds or (names and argv[0] == "check") or any(
+            n not in COMMANDS for n in names):
+        print("usage: python -m boundest._kernels build | verify [COMMAND ...] | check\n"
+              f"commands: {' '.join(COMMANDS)}", file=sys.stderr)
         return 2
-    return cmds[argv[0]]()
+    return cmds[argv[0]](names) if names else cmds[argv[0]]()
 
 
 if __name__ == "__main__":
