@@ -178,26 +178,34 @@ def _writable(path: Path) -> bool:
 def _restamp(index: bytes, source: Path) -> bytes:
     """A cache index whose source stamp fits ``source`` as installed here.
 
-    Numba 0.68 stamps the sha256 of the file's contents: it must equal the installed file's
-    (else ValueError). Older Numbas stamp ``(st_mtime, st_size)``: the size must match, the
-    modification time is replaced by the installed file's.
+    The index is a pickled Numba version, then a pickled ``(stamp, overloads)``. Its opcodes
+    are read (``pickletools.genops``), never executed: unpickling the overloads would import
+    the modules their signatures name, in the middle of importing ``boundest.interval``.
+    Numba 0.68 stamps the sha256 of the source's contents: it must equal the installed
+    file's (else ValueError). Older Numbas stamp ``(st_mtime, st_size)``: the size must match,
+    and the modification time is replaced, in place, by the installed file's.
     """
+    import pickletools
+    import struct
+
     buf = io.BytesIO(index)
-    version = pickle.load(buf)
-    stamp, overloads = pickle.loads(buf.read())
-    st = source.stat()
-    if isinstance(stamp, bytes):
-        if stamp != hashlib.sha256(source.read_bytes()).digest():
+    pickle.load(buf)  # the Numba version: a plain string
+    start = buf.tell()
+    ops = (op for op in pickletools.genops(index[start:]) if op[0].name not in ("PROTO",
+                                                                              "FRAME"))
+    op, arg, pos = next(ops)
+    if op.name in ("SHORT_BINBYTES", "BINBYTES", "BINBYTES8"):
+        if arg != hashlib.sha256(source.read_bytes()).digest():
             raise ValueError(f"{source.name}: source differs from the archive's")
         return index
-    if isinstance(stamp, tuple) and len(stamp) == 2:
-        if stamp[1] != st.st_size:
+    if op.name == "BINFLOAT":
+        size_op, size, _ = next(ops)
+        st = source.stat()
+        if not size_op.name.startswith(("BININT", "LONG")) or size != st.st_size:
             raise ValueError(f"{source.name}: source size differs from the archive's")
-        out = io.BytesIO()
-        pickle.dump(version, out, protocol=-1)
-        out.write(pickle.dumps(((st.st_mtime, st.st_size), overloads), protocol=-1))
-        return out.getvalue()
-    raise ValueError(f"{source.name}: unknown source stamp {type(stamp).__name__}")
+        at = start + pos + 1  # the 8 bytes of the float, after its opcode
+        return index[:at] + struct.pack(">d", st.st_mtime) + index[at + 8:]
+    raise ValueError(f"{source.name}: unknown source stamp ({op.name})")
 
 
 def _write_atomic(path: Path, data: bytes) -> None:
@@ -218,12 +226,20 @@ def _unpack(manifest: dict) -> None:
         for folder in {d.parent for d in dests.values()}:
             if not _writable(folder):
                 raise PermissionError(f"{folder} is not writable")
-        # data files first, indexes last: an index never names a file not yet there
-        for m in sorted(members, key=lambda m: m.name.endswith(".nbi")):
-            data = tar.extractfile(m).read()
-            if m.name.endswith(".nbi") and m.name in sources:
-                data = _restamp(data, _PKG / sources[m.name])
-            _write_atomic(dests[m.name], data)
+        # data files first, indexes last: an index never names a file not yet there; on any
+        # failure what was written goes again (a later import may try once more)
+        written: list[Path] = []
+        try:
+            for m in sorted(members, key=lambda m: m.name.endswith(".nbi")):
+                data = tar.extractfile(m).read()
+                if m.name.endswith(".nbi") and m.name in sources:
+                    data = _restamp(data, _PKG / sources[m.name])
+                _write_atomic(dests[m.name], data)
+                written.append(dests[m.name])
+        except BaseException:
+            for f in written:
+                f.unlink(missing_ok=True)
+            raise
 
 
 def _use_target() -> None:
