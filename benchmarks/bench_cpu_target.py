@@ -13,7 +13,7 @@ range-only robot's tube network (``scenarios.range_only.solve``), the pool robot
 (``scenarios.pool.solve_pool``, one smoothing sweep as ``boundest run pool``).
 
     flock /tmp/boundest-bench.lock .venv/bin/python benchmarks/bench_cpu_target.py \\
-        --out benchmarks/results/cpu_target.json [--repeat 5] [--rounds 2]
+        --out benchmarks/results/cpu_target.json [--repeat 5] [--rounds 2] [--cache-dir D]
 
 The host target's first round compiles every kernel (minutes on 2 cores; not timed). JSON on
 stdout (and ``--out``): per workload the median of every timed call of each target, and the
@@ -87,6 +87,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--out", help="also write the JSON to this file")
     ap.add_argument("--repeat", type=int, default=5, help="timed calls per round (default 5)")
     ap.add_argument("--rounds", type=int, default=2, help="host/generic rounds (default 2)")
+    ap.add_argument("--cache-dir", help="keep the two targets' Numba caches in this folder "
+                    "(default: a temporary one; the host's first round then compiles)")
     ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.worker:
@@ -102,6 +104,7 @@ def main(argv: list[str] | None = None) -> int:
         "runs": []}
     samples: dict = {t: {w: [] for w in WORKLOADS} for t in ("host", "generic")}
     with tempfile.TemporaryDirectory(prefix="bench-cpu-target-") as tmp:
+        tmp = args.cache_dir or tmp
         envs = {
             "host": dict(os.environ, NUMBA_CACHE_DIR=str(Path(tmp) / "host"),
                          BOUNDEST_KERNEL_ARCHIVE="0"),
@@ -134,6 +137,14 @@ def main(argv: list[str] | None = None) -> int:
     doc["ratio_generic_over_host"] = {
         w: round(doc["median_s"][w]["generic"] / doc["median_s"][w]["host"], 3)
         for w in WORKLOADS}
+    # the ratio within each round (host and generic back to back): how much the load moved it
+    per_round = {w: [] for w in WORKLOADS}
+    for r in range(args.rounds):
+        pair = {x["target"]: x for x in doc["runs"] if x["round"] == r}
+        for w in WORKLOADS:
+            per_round[w].append(round(statistics.median(pair["generic"][w]["times_s"])
+                                      / statistics.median(pair["host"][w]["times_s"]), 3))
+    doc["ratio_per_round"] = per_round
     for w in WORKLOADS:
         m = doc["median_s"][w]
         print(f"{w:<12} host {m['host']:.3f} s  {doc['generic_target']} {m['generic']:.3f} s  "
