@@ -3,9 +3,12 @@
 Each command runs as a user runs it, the ``boundest`` console script of this interpreter's
 environment in a fresh process:
 
-* **cold**: with ``NUMBA_CACHE_DIR`` set to a new empty folder, so every kernel the command
-  uses is compiled (the first run after an install);
-* **warm**: ``--repeat`` more runs with that same folder, every kernel loaded from it (the
+* **cold**: with ``NUMBA_CACHE_DIR`` set to a new empty folder (the first run after an
+  install): the shipped kernel archive is unpacked into it (``boundest._kernels``) and
+  nothing compiles when it matches the sources;
+* **cold without the archive**: another empty folder and ``BOUNDEST_KERNEL_ARCHIVE=0``, so
+  every kernel the command uses is compiled (``--skip-without`` leaves these out);
+* **warm**: ``--repeat`` more runs with the first folder, every kernel loaded from it (the
   median and the minimum are recorded).
 
 ``boundest --help`` is timed ``--repeat`` times. With ``--install``, the README's first command
@@ -88,21 +91,32 @@ def timed(argv: list[str], env: dict, cwd: Path, timeout: float) -> dict:
     return out
 
 
-def bench_command(name: str, cmd: list[str], repeat: int, timeout: float) -> dict:
-    """Cold then warm runs of one command in a scratch folder with a fresh cache folder."""
+def bench_command(name: str, cmd: list[str], repeat: int, timeout: float,
+                  without: bool = True) -> dict:
+    """Cold runs of one command (with the shipped kernel archive, then without it), each with a
+    fresh cache folder, then warm runs on the first folder, in a scratch folder."""
     with tempfile.TemporaryDirectory(prefix=f"bench-startup-{name}-") as tmp:
-        env = dict(os.environ, NUMBA_CACHE_DIR=str(Path(tmp) / "numba-cache"))
+        cache = Path(tmp) / "numba-cache"
+        env = dict(os.environ, NUMBA_CACHE_DIR=str(cache))
+        for var in ("BOUNDEST_KERNEL_ARCHIVE", "NUMBA_CPU_NAME", "NUMBA_CPU_FEATURES"):
+            env.pop(var, None)
         argv = [*boundest_script(Path(sys.executable)), *cmd]
         if cmd[0] != "solve":
             argv += ["--out", str(Path(tmp) / "out")]
         cold = timed(argv, env, Path(tmp), timeout)
         warm = [timed(argv, env, Path(tmp), timeout) for _ in range(repeat)]
-        n_files = sum(1 for _ in (Path(tmp) / "numba-cache").rglob("*.nbc"))
-        size = sum(f.stat().st_size for f in (Path(tmp) / "numba-cache").rglob("*.nb*"))
+        n_files = sum(1 for _ in cache.rglob("*.nbc"))
+        size = sum(f.stat().st_size for f in cache.rglob("*.nb*"))
+        cold_without = None
+        if without:
+            cache0 = Path(tmp) / "numba-cache-without"
+            env0 = dict(env, NUMBA_CACHE_DIR=str(cache0), BOUNDEST_KERNEL_ARCHIVE="0")
+            cold_without = timed(argv, env0, Path(tmp), timeout)
+            cold_without["cache_files_nbc"] = sum(1 for _ in cache0.rglob("*.nbc"))
     ws = [w["wall_s"] for w in warm]
     shown = " ".join(cmd).replace(f"{ROOT}{os.sep}", "")
-    return {"command": f"boundest {shown}", "cold": cold, "warm": warm,
-            "warm_median_s": statistics.median(ws) if ws else None,
+    return {"command": f"boundest {shown}", "cold": cold, "cold_without_archive": cold_without,
+            "warm": warm, "warm_median_s": statistics.median(ws) if ws else None,
             "warm_min_s": min(ws) if ws else None,
             "cache_files_nbc": n_files, "cache_bytes": size}
 
@@ -145,6 +159,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--install", action="store_true",
                     help="also time the README's first command in a new virtual environment")
     ap.add_argument("--timeout", type=float, default=900.0, help="per process, seconds")
+    ap.add_argument("--skip-without", action="store_true",
+                    help="skip the cold runs without the kernel archive (they compile)")
     args = ap.parse_args(argv)
     names = list(COMMANDS) if not args.only else args.only.split(",")
     unknown = [n for n in names if n not in COMMANDS]
@@ -154,18 +170,30 @@ def main(argv: list[str] | None = None) -> int:
     import numba
     import numpy
 
+    from boundest import _kernels
+
+    manifest = _kernels.read_manifest() or {}
     doc: dict = {"benchmark": "startup", "machine": {
         "cpu": cpu_model(), "cores": os.cpu_count(), "python": platform.python_version(),
         "numpy": numpy.__version__, "numba": numba.__version__},
+        "kernel_archive": {"refused": _kernels.refusal(_kernels.read_manifest()),
+                           "archive_bytes": manifest.get("archive_bytes"),
+                           "unpacked_bytes": manifest.get("unpacked_bytes"),
+                           "files": len(manifest.get("files", []))},
         "targets": TARGETS, "started_loadavg": loadavg()}
     doc["help"] = bench_help(max(args.repeat, 5))
     print(f"{'boundest --help':<28} median {doc['help']['median_s']:6.2f} s", file=sys.stderr)
     doc["commands"] = {}
     for name in names:
-        r = bench_command(name, COMMANDS[name], args.repeat, args.timeout)
+        r = bench_command(name, COMMANDS[name], args.repeat, args.timeout,
+                          without=not args.skip_without)
         doc["commands"][name] = r
-        print(f"{name:<28} cold {r['cold']['wall_s']:6.1f} s (load {r['cold']['loadavg_before']}"
-              f") warm median {r['warm_median_s']:5.2f} s min {r['warm_min_s']:5.2f} s; rc "
+        c0 = r["cold_without_archive"]
+        without = (f", without archive {c0['wall_s']:6.1f} s (load {c0['loadavg_before']})"
+                   if c0 else "")
+        print(f"{name:<16} cold {r['cold']['wall_s']:6.1f} s (load {r['cold']['loadavg_before']}"
+              f"){without}; warm median {r['warm_median_s']:5.2f} s min "
+              f"{r['warm_min_s']:5.2f} s; rc "
               f"{r['cold']['rc']}; {r['cache_files_nbc']} cached kernels "
               f"{r['cache_bytes'] / 1e6:.1f} MB", file=sys.stderr)
     if args.install:

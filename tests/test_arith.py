@@ -204,7 +204,7 @@ def test_ufunc_loops_load_from_the_disk_cache_in_a_new_process(tmp_path):
     import subprocess
     import sys
 
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path))
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path), BOUNDEST_KERNEL_ARCHIVE="0")
     runs = []
     for _ in range(2):  # compiling, then loading what the first run cached
         out = subprocess.run([sys.executable, "-c", _CACHE_SCRIPT], env=env,

@@ -28,7 +28,7 @@ for f in (engine._revise_piecewise, engine._revise_explog, engine._revise_trig,
 
 @pytest.mark.slow  # a subprocess compiling with an empty cache, about 12 s
 def test_an_arithmetic_tape_compiles_no_transcendental_kernel(tmp_path):
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path))
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path), BOUNDEST_KERNEL_ARCHIVE="0")
     out = subprocess.run([sys.executable, "-c", SCRIPT], env=env, capture_output=True,
                          text=True, timeout=900)
     assert out.returncode == 0, out.stderr[-2000:]

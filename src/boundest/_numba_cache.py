@@ -19,38 +19,66 @@ from pathlib import Path
 _PKG = Path(__file__).parent
 
 
+def cache_folder_for(src_dir: Path) -> Path:
+    """The folder Numba caches the kernels of the sources in ``src_dir`` in (this process)."""
+    root = os.environ.get("NUMBA_CACHE_DIR")
+    if not root:
+        return Path(src_dir) / "__pycache__"
+    sub = os.path.abspath(src_dir)
+    name = f"{os.path.basename(sub)}_{hashlib.sha1(sub.encode()).hexdigest()}"
+    return Path(os.path.abspath(root)) / name
+
+
 def _cache_folders() -> tuple[list[Path], Path]:
     """The folders that may hold the package's cache files, and where to keep the stamp."""
     root = os.environ.get("NUMBA_CACHE_DIR")
     if not root:
         return [_PKG], _PKG / "__pycache__" / "numba-sources.sha256"
     base = Path(os.path.abspath(root))
-    folders = []
-    for src_dir in sorted({p.parent for p in _PKG.rglob("*.py")}):
-        sub = os.path.abspath(src_dir)
-        name = f"{os.path.basename(sub)}_{hashlib.sha1(sub.encode()).hexdigest()}"
-        folders.append(base / name)
+    folders = [cache_folder_for(d) for d in sorted({p.parent for p in _PKG.rglob("*.py")})]
     pkg = os.path.abspath(_PKG)
     return folders, base / f"boundest_{hashlib.sha1(pkg.encode()).hexdigest()}.sha256"
 
 
-def drop_stale_numba_cache() -> None:
-    """Delete the package's ``*.nbi``/``*.nbc`` files if any Numba source changed."""
+def kernels_marker() -> Path:
+    """Where ``_kernels`` records that the shipped kernel archive was unpacked (beside the
+    stamp); dropped with the cache when a Numba source changes."""
+    stamp = _cache_folders()[1]
+    return stamp.with_name(stamp.name.replace("numba-sources.sha256", "boundest-kernels.json")
+                           .replace(".sha256", ".kernels.json"))
+
+
+#: Modules that mention Numba but define no kernel: editing them leaves every cached kernel
+#: valid (and the shipped kernel archive current).
+_NO_KERNELS = frozenset({"_numba_cache.py", "_kernels.py", "cli.py"})
+
+
+def numba_sources_digest() -> str:
+    """sha256 over the package's source files that use Numba (relative path and contents)."""
     digest = hashlib.sha256()
     for src in sorted(_PKG.rglob("*.py")):
+        if src.parent == _PKG and src.name in _NO_KERNELS:
+            continue
         text = src.read_bytes()
         if b"numba" in text:
             digest.update(src.relative_to(_PKG).as_posix().encode())
             digest.update(text)
+    return digest.hexdigest()
+
+
+def drop_stale_numba_cache() -> None:
+    """Delete the package's ``*.nbi``/``*.nbc`` files if any Numba source changed."""
+    digest = numba_sources_digest()
     folders, stamp = _cache_folders()
     try:
-        if stamp.exists() and stamp.read_text() == digest.hexdigest():
+        if stamp.exists() and stamp.read_text() == digest:
             return
         for folder in folders:
             for f in (*folder.rglob("*.nbi"), *folder.rglob("*.nbc")):
                 f.unlink(missing_ok=True)
+        kernels_marker().unlink(missing_ok=True)
         stamp.parent.mkdir(parents=True, exist_ok=True)
-        stamp.write_text(digest.hexdigest())
+        stamp.write_text(digest)
     except OSError:  # read-only install: Numba then caches elsewhere or not at all
         pass
 
@@ -59,7 +87,9 @@ def announce_compilation(what: str, estimate_s: float | None = None) -> None:
     """Print one line on standard error when Numba first compiles a kernel in this process.
 
     Numba reports a compilation (a ``numba:compile`` event) only on a cache miss, so a run
-    that finds every kernel in the on-disk cache prints nothing. Called by the command line
+    that finds every kernel in the on-disk cache (compiled earlier, or unpacked from the
+    shipped kernel archive, ``_kernels``) prints nothing; a kernel the archive lacks is named
+    as such, without the estimate. Called by the command line
     before a command runs; ``what`` names the command, ``estimate_s`` is its measured
     empty-cache compile time on 2 cores (printed as "about N s").
     """
@@ -75,6 +105,13 @@ def announce_compilation(what: str, estimate_s: float | None = None) -> None:
             if self.said:
                 return
             self.said = True
+            from . import _kernels
+
+            if _kernels.STATUS in ("installed", "in use"):  # the archive lacks this one
+                print(f"boundest: compiling a Numba kernel {what} uses that the shipped kernel "
+                      "archive lacks (once: it is cached on disk for later runs) ...",
+                      file=sys.stderr, flush=True)
+                return
             how_long = (f"about {estimate_s:.0f} s on 2 cores" if estimate_s is not None
                         else "it may take a minute")
             print(f"boundest: compiling the Numba kernels {what} uses ({how_long}; once: they "

@@ -15,12 +15,11 @@ import sys
 from . import __version__
 from .commands import SCENARIOS, save_figure, subplots, write_json
 
-#: Measured empty-cache compile time of each command on the project's 2-core machine
-#: (``benchmarks/bench_startup.py``; the pool: 69 s, its observer one compiled kernel; the
-#: satellite: with its shaving kernel, 23 s wall for the whole cold run, measured by hand),
-#: printed when a run starts compiling.
-COMPILE_ESTIMATE_S = {"satellite": 21, "jaulin2001": 11, "range-only": 23,
-                      "drifting-clock": 12, "auv": 20, "pool": 70, "solve": 13, "demo": 5}
+#: Measured empty-cache first run of each command without the shipped kernel archive
+#: (``BOUNDEST_KERNEL_ARCHIVE=0``, ``benchmarks/bench_startup.py``, 2 cores at load 3 from
+#: other jobs), printed when a run starts compiling; with the archive nothing compiles.
+COMPILE_ESTIMATE_S = {"satellite": 34, "jaulin2001": 29, "range-only": 40,
+                      "drifting-clock": 28, "auv": 52, "pool": 130, "solve": 31, "demo": 13}
 
 
 def _demo(args: argparse.Namespace) -> int:

@@ -4,9 +4,11 @@ Names that would shadow Python builtins (``abs``, ``min``, ``max``, ``pow``) are
 ``boundest.abs`` etc. but are left out of ``__all__`` so that ``from boundest import *`` is safe.
 """
 
+from .._kernels import activate as _activate_kernel_archive
 from .._numba_cache import drop_stale_numba_cache
 
 drop_stale_numba_cache()
+_activate_kernel_archive()  # the shipped machine code, before Numba's codegen is set up
 
 from . import algebraic, explog, trig  # noqa: E402
 from .algebraic import *  # noqa: E402, F403

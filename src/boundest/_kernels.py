@@ -1,0 +1,498 @@
+"""The kernel archive: the package's Numba machine code, compiled once and shipped.
+
+An empty Numba cache makes a command's first run compile its kernels (tens of seconds to
+minutes on 2 cores). ``data/kernels.tar.xz`` holds the ``*.nbi``/``*.nbc`` cache files of
+every command's kernels, compiled for a generic x86-64 target (``x86-64-v3``: AVX2, FMA, BMI),
+and ``data/kernels.json`` describes it (Numba, llvmlite, NumPy and Python versions, the
+target, the digest of the package's Numba sources, the files).
+
+At import (``boundest.interval``), :func:`activate` unpacks the archive into the folder Numba
+caches the package's kernels in (``__pycache__`` beside the sources, or under
+``NUMBA_CACHE_DIR``) when that cache holds none of the package's kernels yet, the manifest
+matches the running versions, sources and platform, and the CPU runs the target's
+instructions; the process then compiles for that target, so that Numba's index (keyed on the
+CPU name and features) accepts the entries. When anything does not match, or the folder is
+read-only, it does nothing and kernels compile as before. ``BOUNDEST_KERNEL_ARCHIVE=0``
+disables it.
+
+``python -m boundest._kernels build`` rebuilds the archive (every command once with an empty
+cache, a few minutes), ``verify`` checks it (a fresh cache from the archive, every command,
+no compilation allowed), ``check`` says in one line whether it matches the sources.
+
+This is the only module that relies on Numba internals: the target-machine settings
+(``numba.config.CPU_NAME``/``CPU_FEATURES`` and ``numba.core.registry.cpu_target``), the
+layout of the cache index (a pickled Numba version, then a pickled ``(source stamp,
+overloads)``) and the cache file names. Checked against Numba 0.68.1 (llvmlite 0.50.0),
+whose source stamp is the sha256 of the source file (older Numbas stamp the file's
+``(st_mtime, st_size)``, which :func:`_restamp` rewrites). Any exception from them leaves the
+cache alone, and kernels compile as usual.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import io
+import json
+import os
+import pickle
+import platform
+import sys
+import tarfile
+import tempfile
+from pathlib import Path
+
+from ._numba_cache import _PKG, cache_folder_for, kernels_marker, numba_sources_digest
+
+ARCHIVE = _PKG / "data" / "kernels.tar.xz"
+MANIFEST = _PKG / "data" / "kernels.json"
+ENV_SWITCH = "BOUNDEST_KERNEL_ARCHIVE"
+#: The generic target the archive is compiled for: LLVM's x86-64-v3 level with no extra
+#: features (``NUMBA_CPU_FEATURES=""``: the CPU name implies them), so that the cache key
+#: (triple, CPU name, features) is the same on every x86-64 machine that runs it.
+TARGET_CPU = "x86-64-v3"
+TARGET_FEATURES = ""
+#: LLVM's names of the instruction sets x86-64-v3 implies (v1, v2, v3); the host must have all.
+V3_FEATURES = frozenset({
+    "cmov", "cx8", "fxsr", "mmx", "sse", "sse2",
+    "cx16", "popcnt", "sahf", "sse3", "sse4.1", "sse4.2", "ssse3",
+    "avx", "avx2", "bmi", "bmi2", "f16c", "fma", "lzcnt", "movbe", "xsave"})
+
+#: What the last :func:`activate` did ("installed", "in use", or why not), for messages.
+STATUS = "not checked"
+
+#: name -> arguments of ``boundest``: the commands whose kernels the archive holds
+COMMANDS: dict[str, list[str]] = {
+    "satellite": ["run", "satellite"],
+    "jaulin2001": ["run", "jaulin2001"],
+    "range-only": ["run", "range-only"],
+    "drifting-clock": ["run", "drifting-clock"],
+    "auv": ["run", "auv"],
+    "pool": ["run", "pool"],
+    "solve": ["solve", str(_PKG / "data" / "satellite_k200.txt")],
+    "demo": ["demo"],
+}
+
+
+# --- what the running process is ------------------------------------------------------------
+def running_versions() -> dict[str, str]:
+    """The versions and platform the cache files depend on, for this process."""
+    import llvmlite
+    import numba
+    import numpy
+    from llvmlite import binding as ll
+
+    return {"numba": numba.__version__, "llvmlite": llvmlite.__version__,
+            "numpy": numpy.__version__, "python": platform.python_version(),
+            "triple": ll.get_process_triple()}
+
+
+def _minor(version: str) -> str:
+    return ".".join(version.split(".")[:2])
+
+
+def host_supports_target() -> bool:
+    """Whether this CPU (and OS) runs x86-64-v3 code, by LLVM's host feature detection."""
+    from llvmlite import binding as ll
+
+    if platform.machine().lower() not in ("x86_64", "amd64"):
+        return False
+    ll.initialize_native_target()
+    features = ll.get_host_cpu_features()
+    return all(features.get(f, False) for f in V3_FEATURES)
+
+
+def read_manifest(path: Path | None = None) -> dict | None:
+    """The manifest (default: the shipped one) as a dict, or None when missing or malformed."""
+    try:
+        doc = json.loads(Path(path or MANIFEST).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    need = ("numba", "llvmlite", "numpy", "python", "triple", "cpu_name", "cpu_features",
+            "sources_sha256", "archive_sha256", "files")
+    if not isinstance(doc, dict) or any(k not in doc for k in need):
+        return None
+    if not isinstance(doc["files"], list):
+        return None
+    return doc
+
+
+def refusal(manifest: dict | None, versions: dict | None = None, digest: str | None = None,
+            cpu_ok: bool | None = None) -> str | None:
+    """Why the archive described by ``manifest`` cannot be used here (None: it can).
+
+    Numba and llvmlite must be the very versions the archive was built with, NumPy and
+    Python the same minor version, the platform triple and the digest of the Numba sources
+    the same, and the CPU must run the target's instructions.
+    """
+    if manifest is None:
+        return "no kernel archive (or an unreadable manifest)"
+    versions = running_versions() if versions is None else versions
+    for key in ("numba", "llvmlite", "triple"):
+        if manifest[key] != versions[key]:
+            return f"built with {key} {manifest[key]}, running {versions[key]}"
+    for key in ("numpy", "python"):
+        if _minor(manifest[key]) != _minor(versions[key]):
+            return f"built with {key} {manifest[key]}, running {versions[key]}"
+    digest = numba_sources_digest() if digest is None else digest
+    if manifest["sources_sha256"] != digest:
+        return ("stale: the Numba sources changed since it was built (rebuild: "
+                "python -m boundest._kernels build)")
+    if manifest["cpu_name"] != TARGET_CPU or manifest["cpu_features"] != TARGET_FEATURES:
+        return f"built for CPU {manifest['cpu_name']!r}, this boundest uses {TARGET_CPU!r}"
+    cpu_ok = host_supports_target() if cpu_ok is None else cpu_ok
+    if not cpu_ok:
+        return f"this CPU does not run {TARGET_CPU} code"
+    for var, want in (("NUMBA_CPU_NAME", TARGET_CPU), ("NUMBA_CPU_FEATURES", TARGET_FEATURES)):
+        if var in os.environ and os.environ[var] != want:
+            return f"{var} is set to {os.environ[var]!r}"
+    return None
+
+
+# --- installing -----------------------------------------------------------------------------
+def _destination(member: str) -> Path:
+    """Where an archive member (``<source folder relative to the package>/<file>``) goes."""
+    folder, _, name = member.rpartition("/")
+    if not name or name.startswith(".") or ".." in folder.split("/"):
+        raise ValueError(f"bad archive member {member!r}")
+    src_dir = _PKG if folder in ("", ".") else _PKG / folder
+    return cache_folder_for(src_dir) / name
+
+
+def _package_kernels_cached() -> bool:
+    """Whether the cache location already holds any of the package's kernels."""
+    folders = {cache_folder_for(p.parent) for p in _PKG.rglob("*.py")}
+    return any(next(f.glob("*.nbi"), None) is not None for f in folders if f.is_dir())
+
+
+def _writable(path: Path) -> bool:
+    """Whether ``path`` (created if missing) can take new files."""
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=path):
+            pass
+    except OSError:
+        return False
+    return True
+
+
+def _restamp(index: bytes, source: Path) -> bytes:
+    """A cache index whose source stamp fits ``source`` as installed here.
+
+    The index is a pickled Numba version, then a pickled ``(stamp, overloads)``. Its opcodes
+    are read (``pickletools.genops``), never executed: unpickling the overloads would import
+    the modules their signatures name, in the middle of importing ``boundest.interval``.
+    Numba 0.68 stamps the sha256 of the source's contents: it must equal the installed
+    file's (else ValueError). Older Numbas stamp ``(st_mtime, st_size)``: the size must match,
+    and the modification time is replaced, in place, by the installed file's.
+    """
+    import pickletools
+    import struct
+
+    buf = io.BytesIO(index)
+    pickle.load(buf)  # the Numba version: a plain string
+    start = buf.tell()
+    ops = (op for op in pickletools.genops(index[start:]) if op[0].name not in ("PROTO",
+                                                                              "FRAME"))
+    op, arg, pos = next(ops)
+    if op.name in ("SHORT_BINBYTES", "BINBYTES", "BINBYTES8"):
+        if arg != hashlib.sha256(source.read_bytes()).digest():
+            raise ValueError(f"{source.name}: source differs from the archive's")
+        return index
+    if op.name == "BINFLOAT":
+        size_op, size, _ = next(ops)
+        st = source.stat()
+        if not size_op.name.startswith(("BININT", "LONG")) or size != st.st_size:
+            raise ValueError(f"{source.name}: source size differs from the archive's")
+        at = start + pos + 1  # the 8 bytes of the float, after its opcode
+        return index[:at] + struct.pack(">d", st.st_mtime) + index[at + 8:]
+    raise ValueError(f"{source.name}: unknown source stamp ({op.name})")
+
+
+def _write_atomic(path: Path, data: bytes) -> None:
+    tmp = path.with_name(f"{path.name}.tmp.{os.getpid()}")
+    tmp.write_bytes(data)
+    os.replace(tmp, path)
+
+
+def _unpack(manifest: dict) -> None:
+    """Write the archive's files where Numba looks for them (raises on any problem)."""
+    sources = manifest.get("sources", {})
+    with tarfile.open(ARCHIVE, "r:xz") as tar:
+        members = [m for m in tar.getmembers() if m.isfile()]
+        names = sorted(m.name for m in members)
+        if names != sorted(manifest["files"]):
+            raise ValueError("the archive's files differ from its manifest's")
+        dests = {m.name: _destination(m.name) for m in members}
+        for folder in {d.parent for d in dests.values()}:
+            if not _writable(folder):
+                raise PermissionError(f"{folder} is not writable")
+        # data files first, indexes last: an index never names a file not yet there; on any
+        # failure what was written goes again (a later import may try once more)
+        written: list[Path] = []
+        try:
+            for m in sorted(members, key=lambda m: m.name.endswith(".nbi")):
+                data = tar.extractfile(m).read()
+                if m.name.endswith(".nbi") and m.name in sources:
+                    data = _restamp(data, _PKG / sources[m.name])
+                _write_atomic(dests[m.name], data)
+                written.append(dests[m.name])
+        except BaseException:
+            for f in written:
+                f.unlink(missing_ok=True)
+            raise
+
+
+def _use_target() -> None:
+    """Make this process compile for the archive's target (before Numba's codegen exists)."""
+    from numba.core import config
+
+    config.CPU_NAME = TARGET_CPU
+    config.CPU_FEATURES = TARGET_FEATURES
+
+
+def _codegen_cpu() -> str | None:
+    """The CPU name Numba's CPU codegen was created with (None: not created yet)."""
+    from numba.core import registry
+
+    if "_toplevel_target_context" not in vars(registry.cpu_target):
+        return None
+    return registry.cpu_target.target_context.codegen().magic_tuple()[1]
+
+
+def activate() -> str:
+    """Unpack the archive if it fits and the cache lacks the package's kernels; make this
+    process use the archive's target if the archive is (or was) unpacked in this cache.
+
+    Returns (and records in ``STATUS``) what it did. Never raises.
+    """
+    global STATUS
+    try:
+        STATUS = _activate()
+    except Exception as exc:  # any failure: plain compilation, as before
+        STATUS = f"not used ({type(exc).__name__}: {exc})"
+    return STATUS
+
+
+def _activate() -> str:
+    if os.environ.get(ENV_SWITCH, "1").strip().lower() in ("0", "no", "off", "false"):
+        return f"disabled ({ENV_SWITCH}=0)"
+    manifest = read_manifest()
+    why = refusal(manifest)
+    if why:
+        return f"not used: {why}"
+    cpu = _codegen_cpu()
+    if cpu is not None and cpu != TARGET_CPU:
+        return "not used: Numba's CPU target was set up before boundest was imported"
+    marker = kernels_marker()
+    try:
+        mark = json.loads(marker.read_text())
+    except (OSError, ValueError):
+        mark = None
+    if isinstance(mark, dict) and mark.get("archive_sha256") == manifest["archive_sha256"]:
+        _use_target()
+        return "in use"
+    if _package_kernels_cached():
+        return "not used: the cache already holds kernels compiled on this machine"
+    try:
+        _unpack(manifest)
+        _write_atomic(marker, json.dumps({"archive_sha256": manifest["archive_sha256"],
+                                          "cpu_name": TARGET_CPU}).encode())
+    except OSError as exc:  # read-only or full: leave it, compile as before
+        return f"not used: {exc}"
+    _use_target()
+    return "installed"
+
+
+# --- building and verifying (python -m boundest._kernels build | verify | check) -----------
+def _run_logged(argv: list[str], env: dict, log: Path, timeout: float) -> dict:
+    """``boundest ARGV`` in a new process that records every Numba compilation."""
+    import subprocess
+    import time
+
+    env = dict(env, BOUNDEST_COMPILE_LOG=str(log))
+    t0 = time.perf_counter()
+    p = subprocess.run([sys.executable, "-m", "boundest._kernels", "_run", *argv], env=env,
+                       capture_output=True, text=True, timeout=timeout, check=False)
+    wall = time.perf_counter() - t0
+    try:
+        rec = json.loads(log.read_text())
+    except (OSError, ValueError):
+        rec = {"compiled": None, "status": None}
+    return {"rc": p.returncode, "wall_s": round(wall, 1), **rec,
+            "stderr_tail": p.stderr[-1500:] if p.returncode not in (0, 1) else ""}
+
+
+def _command_argv(name: str, out: Path) -> list[str]:
+    argv = list(COMMANDS[name])
+    return argv if argv[0] == "solve" else [*argv, "--out", str(out)]
+
+
+def _logged_main(argv: list[str]) -> int:
+    """Run ``boundest ARGV``, writing the kernels Numba compiled to $BOUNDEST_COMPILE_LOG."""
+    from numba.core import event
+
+    compiled: list[str] = []
+
+    class _Log(event.Listener):
+        def on_start(self, ev: event.Event) -> None:
+            d = (ev.data or {}).get("dispatcher")
+            f = getattr(d, "py_func", None) or getattr(d, "__wrapped__", None)
+            compiled.append(getattr(f, "__qualname__", None) or repr(d))
+
+        def on_end(self, ev: event.Event) -> None:
+            pass
+
+    event.register("numba:compile", _Log())
+    from .cli import main
+
+    try:
+        rc = _build_all_ufuncs() if argv == ["_ufuncs"] else main(argv)
+    finally:
+        status = getattr(sys.modules.get("boundest._kernels"), "STATUS", None)
+        Path(os.environ["BOUNDEST_COMPILE_LOG"]).write_text(json.dumps(
+            {"compiled": compiled, "status": status}))
+    return rc
+
+
+def _build_all_ufuncs() -> int:
+    """Compile every lazy (g)ufunc the package declares (interval elementary functions...)."""
+    import importlib
+    import pkgutil
+
+    import boundest
+
+    from .interval.rounding import _LazyGufunc, _LazyUfunc
+
+    for info in pkgutil.walk_packages(boundest.__path__, "boundest."):
+        if info.name.startswith(("boundest._kernels", "boundest.__main__")):
+            continue
+        try:
+            mod = importlib.import_module(info.name)
+        except Exception:  # optional extras (scipy, dask) may be missing
+            continue
+        for obj in list(vars(mod).values()):
+            if isinstance(obj, (_LazyGufunc, _LazyUfunc)) and obj._ufunc is None:
+                obj._build()
+    return 0
+
+
+def build(names: list[str] | None = None, timeout: float = 1800.0) -> int:
+    """Compile every command's kernels (or those of ``names``, for a quick try) into a new
+    cache and write the archive and manifest."""
+    import time
+
+    digest = numba_sources_digest()
+    t_start = time.perf_counter()
+    with tempfile.TemporaryDirectory(prefix="boundest-kernels-") as tmp:
+        cache = Path(tmp) / "cache"
+        env = dict(os.environ, NUMBA_CACHE_DIR=str(cache), NUMBA_CPU_NAME=TARGET_CPU,
+                   NUMBA_CPU_FEATURES=TARGET_FEATURES, MPLBACKEND="Agg")
+        env[ENV_SWITCH] = "0"
+        for name in [*(names or COMMANDS), "_ufuncs"]:
+            argv = ["_ufuncs"] if name == "_ufuncs" else _command_argv(name, Path(tmp) / "out")
+            r = _run_logged(argv, env, Path(tmp) / "log.json", timeout)
+            n = len(r["compiled"] or [])
+            print(f"build: {name:<15} {r['wall_s']:6.1f} s, {n} compilations, rc {r['rc']}",
+                  file=sys.stderr, flush=True)
+            if r["rc"] not in (0, 1):
+                print(r["stderr_tail"], file=sys.stderr)
+                return 1
+        files: dict[str, Path] = {}
+        sources: dict[str, str] = {}
+        for src_dir in sorted({p.parent for p in _PKG.rglob("*.py")}):
+            env_dir = _cache_folder_under(cache, src_dir)
+            rel = src_dir.relative_to(_PKG).as_posix()
+            mods = {p.stem for p in src_dir.glob("*.py")}
+            for f in sorted(env_dir.glob("*.nb[ic]")):
+                member = f"{rel}/{f.name}"
+                files[member] = f
+                mod = _module_of(f.name, mods)
+                if f.suffix == ".nbi" and mod:
+                    sources[member] = (src_dir / f"{mod}.py").relative_to(_PKG).as_posix()
+        if not files:
+            print("build: no cache files were written", file=sys.stderr)
+            return 1
+        tmp_archive = Path(tmp) / "kernels.tar.xz"
+        with tarfile.open(tmp_archive, "w:xz", preset=9) as tar:
+            for member, f in files.items():
+                info = tarfile.TarInfo(member)
+                data = f.read_bytes()
+                info.size, info.mtime, info.mode = len(data), 0, 0o644
+                tar.addfile(info, io.BytesIO(data))
+        raw = sum(f.stat().st_size for f in files.values())
+        packed = tmp_archive.read_bytes()
+    if numba_sources_digest() != digest:
+        print("build: the Numba sources changed while building (nothing written): build "
+              "again", file=sys.stderr)
+        return 1
+    manifest = {
+        **running_versions(), "cpu_name": TARGET_CPU, "cpu_features": TARGET_FEATURES,
+        "sources_sha256": digest, "archive_sha256": hashlib.sha256(packed).hexdigest(),
+        "archive_bytes": len(packed), "unpacked_bytes": raw,
+        "commands": list(names or COMMANDS), "files": list(files), "sources": sources}
+    _write_atomic(ARCHIVE, packed)
+    _write_atomic(MANIFEST, (json.dumps(manifest, indent=1) + "\n").encode())
+    print(f"build: {len(files)} files, {raw / 1e6:.1f} MB -> {ARCHIVE} "
+          f"{ARCHIVE.stat().st_size / 1e6:.1f} MB in {time.perf_counter() - t_start:.0f} s",
+          file=sys.stderr)
+    return 0
+
+
+def _cache_folder_under(cache: Path, src_dir: Path) -> Path:
+    sub = os.path.abspath(src_dir)
+    return cache / f"{os.path.basename(sub)}_{hashlib.sha1(sub.encode()).hexdigest()}"
+
+
+def _module_of(filename: str, modules: set[str]) -> str | None:
+    """The module a cache file belongs to: ``[prefix-]module.qualname-line.pyXY...``."""
+    head = filename.split(".", 1)[0]
+    if head in modules:
+        return head
+    if "-" in head and head.split("-", 1)[1] in modules:
+        return head.split("-", 1)[1]
+    return None
+
+
+def verify(names: list[str] | None = None, timeout: float = 900.0) -> int:
+    """Run every command (or ``names``) with a fresh cache from the archive; fail if anything
+    compiles."""
+    bad = 0
+    with tempfile.TemporaryDirectory(prefix="boundest-kernels-verify-") as tmp:
+        env = dict(os.environ, NUMBA_CACHE_DIR=str(Path(tmp) / "cache"), MPLBACKEND="Agg")
+        for var in (ENV_SWITCH, "NUMBA_CPU_NAME", "NUMBA_CPU_FEATURES"):
+            env.pop(var, None)
+        for name in names or COMMANDS:
+            r = _run_logged(_command_argv(name, Path(tmp) / "out"), env,
+                            Path(tmp) / "log.json", timeout)
+            ok = r["rc"] in (0, 1) and r["compiled"] == [] and r["status"] in ("installed",
+                                                                                "in use")
+            bad += not ok
+            print(f"verify: {name:<15} {r['wall_s']:6.1f} s, archive {r['status']}, "
+                  f"compiled {r['compiled']}, rc {r['rc']}: {'ok' if ok else 'FAILED'}",
+                  file=sys.stderr, flush=True)
+    return 1 if bad else 0
+
+
+def check() -> int:
+    """One line: does the shipped archive match the sources and this environment?"""
+    why = refusal(read_manifest())
+    print(f"kernel archive: {'matches the sources and this environment' if why is None else why}")
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    if argv and argv[0] == "_run":
+        return _logged_main(argv[1:])
+    cmds = {"build": build, "verify": verify, "check": check}
+    names = argv[1:]
+    if not argv or argv[0] not in cmds or (names and argv[0] == "check") or any(
+            n not in COMMANDS for n in names):
+        print("usage: python -m boundest._kernels build | verify [COMMAND ...] | check\n"
+              f"commands: {' '.join(COMMANDS)}", file=sys.stderr)
+        return 2
+    return cmds[argv[0]](names) if names else cmds[argv[0]]()
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
