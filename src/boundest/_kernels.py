@@ -373,6 +373,13 @@ def _build_all_ufuncs() -> int:
         for obj in list(vars(mod).values()):
             if isinstance(obj, (_LazyGufunc, _LazyUfunc)) and obj._ufunc is None:
                 obj._build()
+    # a compiled contractor that no command runs (its kernel would compile on first use)
+    from .ctc import CtcPolar
+    from .interval import Interval
+
+    box = Interval([-10.0, -10.0, 1.9, 0.7], [10.0, 10.0, 2.1, 0.8])
+    CtcPolar()(box)
+    CtcPolar(center=(1.0, 2.0))(box)
     return 0
 
 
