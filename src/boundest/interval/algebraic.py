@@ -345,7 +345,8 @@ def _pow_pos(a, n):
         hi = add_up(rh, add_up(rl, ea))
     if not scaled:
         return lo, hi
-    return _scale(lo, re, False), _scale(hi, re, True)
+    # np.bool_, not the literals: one compilation of _scale, not one per Literal[bool]
+    return _scale(lo, re, np.bool_(False)), _scale(hi, re, np.bool_(True))
 
 
 @_jit
@@ -452,14 +453,14 @@ def _root_dn_pos(c, n):
             r = 0.0
     k = 1.0
     while True:
-        t = _step(r, k, True)
+        t = _step(r, k, np.bool_(True))
         if not _below_root(t, c, n):
             break
         r = t
         k *= 2.0
     k *= 0.5
     while k >= 1.0:
-        t = _step(r, k, True)
+        t = _step(r, k, np.bool_(True))
         if _below_root(t, c, n):
             r = t
         k *= 0.5
@@ -482,14 +483,14 @@ def _root_up_pos(c, n):
         return INF
     k = 1.0
     while True:
-        t = _step(r, k, False)
+        t = _step(r, k, np.bool_(False))
         if not _above_root(t, c, n):
             break
         r = t
         k *= 2.0
     k *= 0.5
     while k >= 1.0:
-        t = _step(r, k, False)
+        t = _step(r, k, np.bool_(False))
         if _above_root(t, c, n):
             r = t
         k *= 0.5
