@@ -634,16 +634,19 @@ class CtcLinear(Contractor):
         self.relax = relax
 
     def contract(self, x: Interval) -> Interval:
-        if x.ndim > 1:
+        if x.ndim > 1:  # each box of a batch by its own LPs
             flat = x.reshape(-1, self.n)
             parts = [self.contract(flat[i]) for i in range(flat.shape[0])]
             return Interval._new(np.stack([p.lo for p in parts]).reshape(x.shape),
                                  np.stack([p.hi for p in parts]).reshape(x.shape))
-        lo, hi, ok = contract_slots(self.tape, x.lo, x.hi, self.targets, self.log_linear,
-                                    self.radius, self.relax)
-        if not ok:
-            return Interval.empty(x.shape)
-        return Interval._new(lo, hi)
+        lo, hi, ok = self._contract_box(x.lo, x.hi)
+        return Interval._new(lo, hi) if ok else Interval.empty(x.shape)
+
+    def _contract_box(self, lo: NDArray[np.float64], hi: NDArray[np.float64]
+                      ) -> tuple[NDArray[np.float64], NDArray[np.float64], bool]:
+        """One box's slot bounds contracted: ``(lo, hi, feasible)``."""
+        return contract_slots(self.tape, lo, hi, self.targets, self.log_linear, self.radius,
+                              self.relax)
 
 
 def contract_slots(tape: Tape, lo: NDArray[np.float64], hi: NDArray[np.float64],

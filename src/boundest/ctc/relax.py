@@ -87,8 +87,7 @@ from ..interval import (
     tanh,
 )
 from ..interval.algebraic import abs as iabs
-from .base import Contractor
-from .linear import _linprog, contract_slots
+from .linear import CtcLinear
 
 __all__ = ["CtcPolytopeHull", "RowBlock", "relaxation"]
 
@@ -307,7 +306,7 @@ def relaxation(tape: Tape, lo: NDArray[np.float64], hi: NDArray[np.float64],
     return [r for r in rows if r.n_rows]
 
 
-class CtcPolytopeHull(Contractor):
+class CtcPolytopeHull(CtcLinear):
     """Polytope hull: LP contraction over the linear rows and a linear relaxation of the
     nonlinear nodes around the box, repeated while it pays.
 
@@ -352,29 +351,18 @@ class CtcPolytopeHull(Contractor):
                  radius: int | None = None) -> None:
         if rounds < 1:
             raise ValueError(f"rounds must be at least 1, got {rounds}")
-        _linprog()  # fail at construction, naming the extra, when SciPy is missing
-        self.tape = tape
-        self.n = tape.n_slots
-        self.targets = None if targets is None else np.asarray(targets, dtype=np.int64)
+        super().__init__(tape, targets, log_linear, radius, relax=True)
         self.rounds = rounds
         self.min_gain = min_gain
-        self.log_linear = log_linear
-        self.radius = radius
 
-    def contract(self, x: Interval) -> Interval:
-        if x.ndim > 1:
-            flat = x.reshape(-1, self.n)
-            parts = [self.contract(flat[i]) for i in range(flat.shape[0])]
-            return Interval._new(np.stack([p.lo for p in parts]).reshape(x.shape),
-                                 np.stack([p.hi for p in parts]).reshape(x.shape))
-        lo, hi = x.lo.copy(), x.hi.copy()
+    def _contract_box(self, lo: NDArray[np.float64], hi: NDArray[np.float64]
+                      ) -> tuple[NDArray[np.float64], NDArray[np.float64], bool]:
         sl = slice(None) if self.targets is None else self.targets
         for _ in range(self.rounds):
             w0 = float(np.sum(hi[sl] - lo[sl]))
-            lo, hi, ok = contract_slots(self.tape, lo, hi, self.targets, self.log_linear,
-                                        self.radius, relax=True)
+            lo, hi, ok = super()._contract_box(lo, hi)
             if not ok:
-                return Interval.empty(x.shape)
+                return lo, hi, False
             if not np.sum(hi[sl] - lo[sl]) < (1.0 - self.min_gain) * w0:
                 break
-        return Interval._new(lo, hi)
+        return lo, hi, True
