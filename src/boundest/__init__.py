@@ -15,7 +15,11 @@ from __future__ import annotations
 import importlib
 from typing import Any
 
+from ._malloc import keep_freed_memory as _keep_freed_memory
+
 __version__ = "0.1.0"
+
+_keep_freed_memory()  # glibc: no page faults for re-allocated temporaries (see _malloc)
 
 #: name -> submodule that defines it (the interval names and the dispatching elementary
 #: functions are looked up in ``interval`` and ``expr.functions``, see ``__getattr__``)
