@@ -42,3 +42,10 @@ def test_bad_arguments_exit_with_usage_error():
         main(["nonsense"])
     with pytest.raises(ValueError, match="positive"):
         fe.enclose(0)
+
+
+def test_jaulin2001_summary_states_its_mode(tmp_path, capsys):
+    # boxes: the quick mode; the line names the default it stands against
+    assert main(["run", "jaulin2001", "--boxes", "--out", str(tmp_path)]) == 0
+    text = capsys.readouterr().out
+    assert "mode: boxes, hull consistency" in text and "the default subpavings" in text

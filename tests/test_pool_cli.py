@@ -64,6 +64,7 @@ def test_pool_summary_states_the_guarantee(pool_run):
     assert "P(at most 4 outliers in 40 pings)" in text
     assert "every window since the last restart" in text
     assert "empty steps (restarts):" in text and "most pings rejected in a window" in text
+    assert "mode: smoothing inside the window" in text and "--sweeps 0: 0.02 s" in text
 
 
 def test_pool_bad_data_folder(tmp_path, capsys):

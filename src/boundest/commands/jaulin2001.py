@@ -8,6 +8,16 @@ import math
 
 from . import pyplot, save_figure, write_json
 
+#: The choice of domains and what the other one costs (embedded data, whole boundest process
+#: warm: subpavings at eps 0.01 2.8 s, boxes 0.6 s; non-causal hull of x(10)).
+SUBPAVINGS_LINE = ("mode: subpavings at eps = {eps:g} (the default domains; --boxes: hull "
+                   "consistency on one box per k, about 4x faster, but a box cannot hold the "
+                   "arcs of x(k): x(10) 5.1 x 6.0 against 0.20 x 0.29 at eps 0.01; a larger "
+                   "--eps is faster and coarser)")
+BOXES_LINE = ("mode: boxes, hull consistency on one box per k (the default subpavings keep the "
+              "arcs of x(k): x(10) 0.20 x 0.29 against 5.1 x 6.0 at eps 0.01, about 4x the "
+              "time)")
+
 
 def run(args: argparse.Namespace) -> int:
     from ..plot import plot_set_sequence
@@ -27,6 +37,7 @@ def run(args: argparse.Namespace) -> int:
             return " x ".join(f"[{_f(a)}, {_f(b)}]"
                               for a, b in zip(row["hull_lo"], row["hull_hi"], strict=True))
         print(f"{r['k']:>3} {fmt(r):>40} {r['boxes']:>6}   {fmt(n):>40} {n['boxes']:>6}")
+    print("  " + (BOXES_LINE if args.boxes else SUBPAVINGS_LINE.format(eps=args.eps)))
     empty = any(math.isnan(s["hull_lo"][0]) for e in ("rcse", "ncse") for s in data[e]["sets"])
     if empty:
         print("proven INCONSISTENT: an empty set (the data contradict the model)")
