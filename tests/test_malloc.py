@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import platform
 import subprocess
 import sys
 
@@ -10,7 +11,7 @@ import pytest
 
 from boundest import _malloc
 
-GLIBC = sys.platform.startswith("linux") and os.confstr("CS_GNU_LIBC_VERSION").startswith("glibc")
+GLIBC = sys.platform.startswith("linux") and platform.libc_ver()[0] == "glibc"
 
 PROBE = "import boundest._malloc as m; print(m.keep_freed_memory())"
 
