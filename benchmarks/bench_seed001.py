@@ -39,6 +39,7 @@ import statistics
 import subprocess
 import sys
 import time
+from decimal import Decimal
 from pathlib import Path
 from typing import Any
 
@@ -85,11 +86,13 @@ def _other_mode(solve: Any, width: Any, repeat: int) -> dict:
             "iterations": res.iterations, **width(res)}
 
 
-def _bench_robot(ro: Any, dt: float, repeat: int, rate: str) -> tuple[dict, Any]:
+def _bench_robot(ro: Any, dt: float, repeat: int, rate: str,
+                 rel_eps: float) -> tuple[dict, Any]:
     t0 = time.perf_counter()
-    first = ro.solve(dt=dt, progress=False, rate=rate)
+    first = ro.solve(dt=dt, progress=False, rate=rate, rel_eps=rel_eps)
     first_wall = time.perf_counter() - t0
-    times, res = _timed(lambda: ro.solve(dt=dt, progress=False, rate=rate), repeat)
+    times, res = _timed(lambda: ro.solve(dt=dt, progress=False, rate=rate, rel_eps=rel_eps),
+                        repeat)
     d = res.position_diagonal()
     s = res.x.t
     truth = ro.RobotTruth().states(s)
@@ -109,17 +112,17 @@ def _bench_robot(ro: Any, dt: float, repeat: int, rate: str) -> tuple[dict, Any]
            "time_deriv": res.time_deriv, "rate": rate,
            "other_mode": _other_mode(
                lambda: ro.solve(dt=dt, progress=False, time_deriv=not res.time_deriv,
-                                rate=rate),
+                                rate=rate, rel_eps=rel_eps),
                lambda r: {"mean_diagonal_m": float(np.mean(r.position_diagonal())),
                           "t_width_sum": float(np.sum(r.t.width()))}, min(repeat, 3))}
     return rec, res
 
 
-def _bench_clock(dc: Any, dt: float, repeat: int) -> tuple[dict, Any]:
+def _bench_clock(dc: Any, dt: float, repeat: int, rel_eps: float) -> tuple[dict, Any]:
     t0 = time.perf_counter()
-    first = dc.solve(dt=dt)
+    first = dc.solve(dt=dt, rel_eps=rel_eps)
     first_wall = time.perf_counter() - t0
-    times, res = _timed(lambda: dc.solve(dt=dt), repeat)
+    times, res = _timed(lambda: dc.solve(dt=dt, rel_eps=rel_eps), repeat)
     truth = dc.ClockTruth()
     t_exact = truth.inverse_drift((res.meas.tau.lo + res.meas.tau.hi) / 2)
     rec = {"time_s": statistics.median(times), "time_min_s": min(times), "times_s": times,
@@ -136,7 +139,7 @@ def _bench_clock(dc: Any, dt: float, repeat: int) -> tuple[dict, Any]:
                                   and res.t.contains(t_exact).all()),
            "time_deriv": res.time_deriv,
            "other_mode": _other_mode(
-               lambda: dc.solve(dt=dt, time_deriv=not res.time_deriv),
+               lambda: dc.solve(dt=dt, time_deriv=not res.time_deriv, rel_eps=rel_eps),
                lambda r: {"t_width_sum": float(np.sum(r.t.width())),
                           "t_i": [[_r(float(a), 4), _r(float(b), 4)]
                                   for a, b in zip(r.t.lo, r.t.hi, strict=True)]}, repeat)}
@@ -148,6 +151,20 @@ def _robot_label(dt: float, rate: str) -> str:
 
 
 # -- Codac (subprocess) ----------------------------------------------------------------------
+def _clock_consts(dc: Any) -> dict:
+    """boundest's enclosures of the clock's decimal constants, as exact decimal strings.
+
+    Codac 1.5.7 parses constants in the upward rounding mode it sets at import (its lower
+    bound of 0.97 is the double above 0.97: it excludes the decimal). The exact decimal
+    expansion of a double parses to that double in any rounding mode, so both libraries see
+    the same floats.
+    """
+    def dec(x: Any) -> list[str]:
+        return [format(Decimal(float(x.lo)), "f"), format(Decimal(float(x.hi)), "f")]
+    return {"rate": dec(dc.RATE), "offset": dec(dc.OFFSET), "x_offset": [dec(v) for v in
+            dc.X_OFFSET], "v_error": dec(dc.V_ERROR)}
+
+
 def _codac_spec(ro: Any, dc: Any, robot: list[dict], clock: list[dict],
                 args: argparse.Namespace) -> dict:
     meas = ro.load()
@@ -166,7 +183,8 @@ def _codac_spec(ro: Any, dc: Any, robot: list[dict], clock: list[dict],
     cm = dc.load()
     cases += [{"kind": "clock", "label": f"clock dt={row['dt']:g}",
                "dt": float(row["dt"]).hex(), "tf": float(row["boundest"]["tf"]).hex(),
-               "tau": _h((cm.tau.lo + cm.tau.hi) / 2), "z_lo": _h(cm.z.lo),
+               "tau_lo": _h(cm.tau.lo), "tau_hi": _h(cm.tau.hi), "z_lo": _h(cm.z.lo),
+               "consts": _clock_consts(dc),
                "z_hi": _h(cm.z.hi), "rel_eps": float(args.rel_eps).hex(), "max_iter": 200,
                "every": max(1, round(0.01 / row["dt"]))}
               for row in clock]
@@ -233,7 +251,21 @@ def _codac_clock_row(rec: dict, b_rec: dict, b_res: Any, dc: Any) -> dict:
     row["t_i_wider_than_codac"] = int(np.sum(bw > cw))
     row["t_i_max_excess_over_codac"] = float(np.max((bw - cw) / cw))
     row["t_i_max_excess_over_codac_abs"] = float(np.max(bw - cw))
+    # bound by bound, in ulps: > 0 where boundest's bound lies outside Codac's
+    lo_ulps = _ulps_between(b_res.t.lo, t_lo)
+    hi_ulps = _ulps_between(t_hi, b_res.t.hi)
+    row["t_lo_ulps_outside_codac"] = [int(v) for v in lo_ulps]
+    row["t_hi_ulps_outside_codac"] = [int(v) for v in hi_ulps]
+    row["t_i_bounds_outside_codac"] = int(np.sum(lo_ulps > 0) + np.sum(hi_ulps > 0))
     return row
+
+
+def _ulps_between(a: Any, b: Any) -> np.ndarray:
+    """The number of doubles from ``a`` up to ``b`` (negative where ``b < a``)."""
+    def key(x: Any) -> np.ndarray:
+        i = np.asarray(x, dtype=np.float64).view(np.int64)
+        return np.where(i < 0, np.int64(-(2**63)) - i, i)   # monotone in the float's value
+    return key(b) - key(a)
 
 
 def _machine() -> dict:
@@ -285,9 +317,11 @@ def main() -> None:
     for dt in dts:
         for rate in [v for v in args.rates.split(",") if v]:
             t0 = time.perf_counter()
-            ro.solve(dt=dt, progress=False, rate=rate)  # warm-up (the first also loads kernels)
+            # warm-up (the first also loads kernels)
+            ro.solve(dt=dt, progress=False, rate=rate, rel_eps=args.rel_eps)
             slow = time.perf_counter() - t0 > 10
-            rec, res = _bench_robot(ro, dt, args.repeat_slow if slow else args.repeat, rate)
+            rec, res = _bench_robot(ro, dt, args.repeat_slow if slow else args.repeat, rate,
+                                    args.rel_eps)
             print(f"boundest robot dt={dt:g} rate={rate}: {rec['time_s']:.3f} s, "
                   f"{rec['iterations']} iterations, mean d {rec['mean_diagonal_m']:.3f} m",
                   file=sys.stderr)
@@ -296,7 +330,7 @@ def main() -> None:
     clock_dts = [0.01] if args.quick else [float(v) for v in args.clock_dts.split(",")]
     clock = []
     for dt in clock_dts:
-        crec, cres = _bench_clock(dc, dt, args.repeat)
+        crec, cres = _bench_clock(dc, dt, args.repeat, args.rel_eps)
         print(f"boundest clock dt={dt:g}: {crec['time_s']:.4f} s, {crec['iterations']} "
               f"iterations, sum of [t_i] widths {crec['t_width_sum']:.4f}", file=sys.stderr)
         clock.append({"dt": dt, "boundest": crec})
@@ -355,6 +389,7 @@ def main() -> None:
                 line[f"codac_{c['variant']}_t_width_sum"] = _r(c["t_width_sum"])
                 line[f"codac_{c['variant']}_h_mean_width"] = _r(c["h_mean_width"])
                 line[f"t_i_wider_than_codac_{c['variant']}"] = c["t_i_wider_than_codac"]
+                line[f"t_i_bounds_outside_codac_{c['variant']}"] = c["t_i_bounds_outside_codac"]
                 line[f"speedup_{c['variant']}"] = _r(c["speedup"], 2)
         table.append(line)
     doc = {"benchmark": "seed001", "started": started, "machine": _machine(),

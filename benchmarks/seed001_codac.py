@@ -240,9 +240,15 @@ def main() -> None:
         dt, tf = case["dt"], case["tf"]
         tdom = Interval(0.0, tf)
         t_build = time.perf_counter()
-        x = TubeVector(tdom, dt, TFunction("([70,90]+100*cos(t) ; [10,30]+100*sin(t))"))
-        v = TubeVector(tdom, dt, TFunction("([-0.1,0.1]-100*sin(t) ; [-0.1,0.1]+100*cos(t))"))
-        phi = Tube(tdom, dt, TFunction("[0.08,0.12]*t+[0.97,1.08]"))
+        # the constants as boundest encloses them, written exactly (see _clock_consts)
+        c = case["consts"]
+
+        def iv(b: list[str]) -> str:
+            return f"[{b[0]},{b[1]}]"
+        x1o, x2o, ve = iv(c["x_offset"][0]), iv(c["x_offset"][1]), iv(c["v_error"])
+        x = TubeVector(tdom, dt, TFunction(f"({x1o}+100*cos(t) ; {x2o}+100*sin(t))"))
+        v = TubeVector(tdom, dt, TFunction(f"({ve}-100*sin(t) ; {ve}+100*cos(t))"))
+        phi = Tube(tdom, dt, TFunction(f"{iv(c['rate'])}*t+{iv(c['offset'])}"))
         h = Tube(tdom, dt)
         h.set(Interval(0.0), 0.0)
         y, w = Tube(tdom, dt), Tube(tdom, dt)
@@ -251,8 +257,8 @@ def main() -> None:
         ctc_deriv.preserve_slicing(True)
         ctc_eval = CtcEval()
         ctc_eval.preserve_slicing(True)
-        ts = [Interval(0.0, tf) for _ in case["tau"]]
-        taus = [Interval(a) for a in case["tau"]]
+        ts = [Interval(0.0, tf) for _ in case["tau_lo"]]
+        taus = [Interval(a, b) for a, b in zip(case["tau_lo"], case["tau_hi"], strict=True)]
         zs = [Interval(a, b) for a, b in zip(case["z_lo"], case["z_hi"], strict=True)]
         if variant == "cn":
             g = Function("y", "w", "x[2]", "v[2]", g_src.replace("x1", "x[0]")
