@@ -14,8 +14,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import mpmath
 import numpy as np
 
 from ..estimation import ChainEstimate, DiscreteSystem, ncse, rcse
@@ -24,6 +24,9 @@ from ..expr.functions import sin as _sin
 from ..interval import Interval
 from ..paving import Subpaving
 from ._data import check_index, embedded, read_csv
+
+if TYPE_CHECKING:
+    import mpmath
 
 __all__ = ["FRAME", "NOISE", "Jaulin2001", "Simulation", "load", "simulate", "solve", "system",
            "to_json"]
@@ -67,8 +70,14 @@ def simulate(x0: tuple[float, float], K: int = 10, seed: int | None = None,
     The trajectory is computed with mpmath at 40 digits (the map expands errors about 6 times
     per step: 1e-40 * 6^10 is far below a float's resolution), so it is the exact trajectory to
     float precision; ``Y(k) = y_m(k) + [-noise, noise]`` is rounded outward, and it is checked
-    exactly that it contains ``y*(k)``.
+    exactly that it contains ``y*(k)``. Needs mpmath (``pip install mpmath``; the ``test``
+    extra has it), which the commands do not.
     """
+    try:
+        import mpmath
+    except ImportError as exc:
+        raise ImportError("jaulin2001.simulate needs mpmath for its exact trajectory: "
+                          "pip install mpmath (or boundest[test])") from exc
     rng = np.random.default_rng(seed)
     with mpmath.workdps(40):
         x = [(mpmath.mpf(x0[0]), mpmath.mpf(x0[1]))]
