@@ -380,7 +380,40 @@ def _build_all_ufuncs() -> int:
     box = Interval([-10.0, -10.0, 1.9, 0.7], [10.0, 10.0, 2.1, 0.8])
     CtcPolar()(box)
     CtcPolar(center=(1.0, 2.0))(box)
+    from .interval.relaxed import qinter  # CtcQInter and RobustObserver; no command runs it
+
+    qinter(Interval([[0.0], [1.0]], [[2.0], [3.0]]), 1)
+    _build_engine_variants()
     return 0
+
+
+#: one operator of each family of ``boundest.ctc.revise.FAMILIES``, in the model text format
+_FAMILY_TERMS = {"piecewise": "abs(x)", "pown": "x^3", "explog": "exp(y)", "trig": "sin(x)"}
+
+
+def _build_engine_variants() -> None:
+    """Compile the hull-consistency kernels for every combination of operator families.
+
+    ``propagate`` and ``CtcFwdBwd`` pass each family that a tape does not use as ``None``, so
+    that Numba prunes its branches: one specialisation per combination (16). The commands use
+    a few of them; with all of them in the archive a user's own model compiles nothing in
+    hull-consistency mode, whatever operators it has (the other modes compile on first use).
+    """
+    from itertools import combinations
+
+    from .csp import propagate
+    from .ctc import CtcFwdBwd
+    from .expr import parse_model
+    from .interval import Interval
+
+    names = list(_FAMILY_TERMS)
+    for r in range(len(names) + 1):
+        for chosen in combinations(names, r):
+            terms = " + ".join(["y", *(_FAMILY_TERMS[n] for n in chosen)])
+            model = parse_model(f"Variables x in [-1, 1], y in [-1, 1], z in [-9, 9];\n"
+                                f"Constraints z = {terms};")
+            propagate(model)
+            CtcFwdBwd(model, ["x", "y", "z"])(Interval([-1.0, -1.0, -9.0], [1.0, 1.0, 9.0]))
 
 
 def build(names: list[str] | None = None, timeout: float = 1800.0) -> int:
