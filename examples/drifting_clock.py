@@ -31,17 +31,12 @@ def dec(lo: float, hi: float) -> bd.Interval:
     return bd.Interval(np.nextafter(lo, -np.inf), np.nextafter(hi, np.inf))
 
 
-def box(*parts: bd.Interval) -> bd.Interval:
-    """Boxes (..., d) from d intervals of the same shape."""
-    return bd.Interval(np.stack([p.lo for p in parts], -1), np.stack([p.hi for p in parts], -1))
-
-
 def boat(s: bd.Interval) -> bd.Interval:  # equation 18, over the time intervals s
-    return box(dec(70, 90) + 100 * bd.cos(s), dec(10, 30) + 100 * bd.sin(s))
+    return bd.Interval.stack([dec(70, 90) + 100 * bd.cos(s), dec(10, 30) + 100 * bd.sin(s)])
 
 
 def boat_velocity(s: bd.Interval) -> bd.Interval:  # equation 19
-    return box(dec(-0.1, 0.1) - 100 * bd.sin(s), dec(-0.1, 0.1) + 100 * bd.cos(s))
+    return bd.Interval.stack([dec(-0.1, 0.1) - 100 * bd.sin(s), dec(-0.1, 0.1) + 100 * bd.cos(s)])
 
 
 def rate(s: bd.Interval) -> bd.Interval:  # equation 17: the bounds of h'(t)

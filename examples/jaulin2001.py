@@ -41,17 +41,12 @@ def g(x) -> list:
     return [bd.abs(x[0])]
 
 
-def box(*parts: bd.Interval) -> bd.Interval:
-    """A box from its components (0-d intervals)."""
-    return bd.Interval([p.lo for p in parts], [p.hi for p in parts])
-
-
 # the truth, enclosed: X[k] is a thin box around the exact x(k) from x(0) = (1, 0.5)
 X = [bd.Interval([1.0, 0.5])]
 for _ in range(K):
-    X.append(box(*f(X[-1])))
+    X.append(bd.Interval.stack(f(X[-1])))
 rng = np.random.default_rng(3)
-y_true = box(*(g(x)[0] for x in X[1:]))                          # |x1(k)|, k = 1..K
+y_true = bd.Interval.stack([g(x)[0] for x in X[1:]])        # |x1(k)|, k = 1..K
 Y = bd.Interval(y_true.mid() + rng.uniform(-0.9, 0.9, K) * NOISE) + bd.Interval(-NOISE, NOISE)
 assert bool(np.all(Y.contains(y_true))), "a measurement interval misses the true output"
 

@@ -35,21 +35,13 @@ sonar = bd.ctc.CtcRayCast(data.map)
 PAD = 2.0**-50                   # covers the float64 rounding of the simulated Euler steps
 
 
-def box(*parts: bd.Interval) -> bd.Interval:
-    """Boxes (..., d) from d intervals (broadcast together; empty ones allowed)."""
-    out = bd.Interval.empty((*np.broadcast_shapes(*(p.shape for p in parts)), len(parts)))
-    for i, p in enumerate(parts):
-        out[..., i] = p
-    return out
-
-
 def predict(X: bd.Interval, u: bd.Interval) -> bd.Interval:
     """One Euler step ``X + dt f(X, u)`` of boxes X (..., 4), widened by the float rounding."""
     x, y, th, v, u1, u2 = X[..., 0], X[..., 1], X[..., 2], X[..., 3], u[..., 0], u[..., 1]
-    inc = data.dt * box(v * bd.cos(th), v * bd.sin(th), u2 - u1, u1 + u2 - v)
+    inc = data.dt * bd.Interval.stack([v * bd.cos(th), v * bd.sin(th), u2 - u1, u1 + u2 - v])
     # v + dt (u1 + u2 - v) written with v once: (1 - dt) v shrinks, v - dt v would grow
     v_next = (1 - bd.Interval(data.dt)) * v + data.dt * (u1 + u2)
-    X_next = box(x + inc[..., 0], y + inc[..., 1], th + inc[..., 2], v_next)
+    X_next = bd.Interval.stack([x + inc[..., 0], y + inc[..., 1], th + inc[..., 2], v_next])
     return X_next.inflate(PAD * inc.mag(), PAD)
 
 
@@ -57,8 +49,8 @@ def observe(X: bd.Interval, ping: tuple[float, bd.Interval]) -> bd.Interval:
     """X contracted by one ping: the first hit along the beam theta + alpha is at d."""
     alpha, d = ping
     d = d.inflate(0.0, 2.0**-40)  # the float64 evaluation of the simulated distance
-    c = sonar(box(X[0], X[1], X[2] + alpha, d))
-    return box(c[0], c[1], X[2] & (c[2] - alpha), X[3])
+    c = sonar(bd.Interval.stack([X[0], X[1], X[2] + alpha, d]))
+    return bd.Interval.stack([c[0], c[1], X[2] & (c[2] - alpha), X[3]])
 
 
 # at any time: inside the pool, any heading, |v| below the largest |u1 + u2| or |v(0)|

@@ -45,7 +45,7 @@ def inputs(s: bd.Interval) -> bd.Interval:
     e = bd.Interval(-1e-3, 1e-3)
     u1 = -bd.Interval(9.0) / 20 * bd.cos(s / 5) + e
     u2 = bd.Interval(1.0) / 10 + bd.sin(s / 4) + e
-    return bd.Interval(np.stack([u1.lo, u2.lo], -1), np.stack([u1.hi, u2.hi], -1))
+    return bd.Interval.stack([u1, u2])
 
 
 u = bd.Tube.from_function_on(t, inputs)

@@ -4,6 +4,8 @@ from fractions import Fraction
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import boundest as bd
 from boundest import Interval, IntervalVector
@@ -150,3 +152,28 @@ def test_volume_is_an_upper_bound_of_the_exact_volume():
             exact *= Fraction(hi[b, i]) - Fraction(lo[b, i])
         assert exact <= Fraction(vol[b]) <= exact * (1 + Fraction(1, 2**48))
     assert Interval([0, 0], [0, 1e300]).volume() == 0.0  # a degenerate box has volume 0
+
+
+@settings(max_examples=60)
+@given(st.lists(st.tuples(st.floats(-1e6, 1e6), st.floats(0, 1e3), st.booleans()), min_size=1,
+                max_size=4), st.integers(1, 3))
+def test_stack_keeps_every_component(parts, n):
+    ivs = [Interval.empty(n) if empty else Interval(np.full(n, a), np.full(n, a + w))
+           for a, w, empty in parts]
+    for axis in (-1, 0):
+        box = Interval.stack(ivs, axis=axis)
+        assert box.shape == ((n, len(ivs)) if axis == -1 else (len(ivs), n))
+        for i, v in enumerate(ivs):
+            got = box[..., i] if axis == -1 else box[i]
+            assert np.array_equal(got.lo, v.lo, equal_nan=True)
+            assert np.array_equal(got.hi, v.hi, equal_nan=True)
+
+
+def test_stack_broadcasts_numbers_and_rejects_mismatched_shapes():
+    box = Interval.stack([Interval([0.0, 1.0], [1.0, 2.0]), 5.0])
+    assert np.array_equal(box.lo, [[0.0, 5.0], [1.0, 5.0]])
+    assert np.array_equal(box.hi, [[1.0, 5.0], [2.0, 5.0]])
+    with pytest.raises(ValueError, match="do not broadcast"):
+        Interval.stack([Interval.empty(2), Interval.empty(3)])
+    with pytest.raises(ValueError, match="at least one"):
+        Interval.stack([])

@@ -7,7 +7,7 @@ Bounds are never ``lo = +inf`` or ``hi = -inf``.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from typing import Any
 
 import numpy as np
@@ -134,6 +134,34 @@ class Interval:
         if arr.ndim == 0 or arr.shape[-1] != 2:
             raise ValueError(f"bounds must have a last axis of length 2, got shape {arr.shape}")
         return cls(arr[..., 0], arr[..., 1])
+
+    @classmethod
+    def stack(cls, parts: Sequence[ArrayLike | Interval], axis: int = -1) -> Interval:
+        """Join intervals of one shape (broadcast together) along a new axis, as ``np.stack``.
+
+        The usual use is a box from its components: ``Interval.stack([x, y])`` of two intervals
+        of shape ``(n,)`` is ``n`` boxes of shape ``(n, 2)``. Empty components stay empty;
+        numbers are degenerate intervals.
+
+        Examples
+        --------
+        >>> Interval.stack([Interval(0, 1), Interval(2, 3)])
+        Interval([[0.0, 1.0], [2.0, 3.0]])
+        >>> Interval.stack([Interval([0, 1], [1, 2]), 5.0]).shape
+        (2, 2)
+        """
+        ivs = [as_interval(p) for p in parts]
+        if not ivs:
+            raise ValueError("Interval.stack needs at least one interval")
+        try:
+            shape = np.broadcast_shapes(*(v.shape for v in ivs))
+        except ValueError as exc:
+            raise ValueError("Interval.stack: the shapes "
+                             f"{', '.join(str(v.shape) for v in ivs)} do not broadcast "
+                             "together") from exc
+        lo = np.stack([np.broadcast_to(v.lo, shape) for v in ivs], axis=axis)
+        hi = np.stack([np.broadcast_to(v.hi, shape) for v in ivs], axis=axis)
+        return cls._new(lo, hi)
 
     def to_bounds(self) -> NDArray[np.float64]:
         """The bounds as one array of shape ``(..., 2)``."""
