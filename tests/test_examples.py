@@ -16,21 +16,14 @@ import pytest
 
 from boundest.commands import SCENARIOS
 
+from .core_install import HIDE_EXTRAS
+
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 SCRIPTS = sorted(p.name for p in EXAMPLES.glob("*.py"))
 #: scripts over about 5 s (run by ``pytest -m slow``); none is, on the 2-core machine (1-4 s)
 SLOW: set[str] = set()
-#: what the extras bring and the core install lacks (as in test_core_install.py)
-EXTRAS_ONLY = ("mpmath", "scipy", "hypothesis", "dask", "distributed", "pytest", "filterpy")
-
-_RUN = f"""
-import importlib.abc, runpy, sys
-class Hide(importlib.abc.MetaPathFinder):
-    def find_spec(self, name, path=None, target=None):
-        if name.split(".")[0] in {EXTRAS_ONLY!r}:
-            raise ImportError(f"{{name}} is not in the core install (hidden by the test)")
-        return None
-sys.meta_path.insert(0, Hide())
+_RUN = HIDE_EXTRAS + """
+import runpy
 sys.argv = [sys.argv[1]]
 runpy.run_path(sys.argv[0], run_name="__main__")
 """
