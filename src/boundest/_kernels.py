@@ -68,6 +68,7 @@ COMMANDS: dict[str, list[str]] = {
     "drifting-clock": ["run", "drifting-clock"],
     "auv": ["run", "auv"],
     "pool": ["run", "pool"],
+    "pool-online": ["run", "pool", "--online"],
     "solve": ["solve", str(_PKG / "data" / "satellite_k200.txt")],
     "demo": ["demo"],
 }
