@@ -61,7 +61,7 @@ anywhere = bd.Interval([*corners.min(axis=0), -np.inf, -vmax],
 obs = RobustObserver(predict, observe, data.x0, m=M, q=Q, restart=anywhere)
 steps = [obs.update(data.inputs[k - 1] if k else None, (data.alpha[k], data.ranges[k]))
          for k in range(data.n)]
-X = bd.Interval(np.array([s.box.lo for s in steps]), np.array([s.box.hi for s in steps]))
+X = bd.Interval.stack([s.box for s in steps], axis=0)
 
 w = X.width()
 print(f"{data.n} pings, P(at most {Q} outliers in {M} pings) = "
