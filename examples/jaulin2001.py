@@ -51,8 +51,9 @@ Y = bd.Interval(y_true.mid() + rng.uniform(-0.9, 0.9, K) * NOISE) + bd.Interval(
 assert bool(np.all(Y.contains(y_true))), "a measurement interval misses the true output"
 
 system = bd.DiscreteSystem(f, g, nx=2, ny=1)
-causal = bd.rcse(system, Y.reshape(K, 1), x0=FRAME, domains="subpavings", eps=EPS)
-smooth = bd.ncse(system, Y.reshape(K, 1), x0=FRAME, domains="subpavings", eps=EPS)
+# both estimators at once: NCSE continues from the RCSE's sets (bd.rcse and bd.ncse alone
+# give the same sets, in about twice the time)
+causal, smooth = bd.rcse_ncse(system, Y.reshape(K, 1), x0=FRAME, domains="subpavings", eps=EPS)
 
 
 def holds(domain: bd.Subpaving | bd.Interval, box: bd.Interval) -> bool:

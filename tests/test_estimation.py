@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from boundest import Interval
-from boundest.estimation import DiscreteSystem, cse, ncse, rcse
+from boundest.estimation import DiscreteSystem, cse, ncse, rcse, rcse_ncse
 from boundest.paving import Subpaving
 from boundest.scenarios import jaulin2001 as jw
 
@@ -89,6 +89,38 @@ def test_the_seed_data_set_is_consistent_and_contains_the_seed_truth():
     assert np.array_equal(a.boxes.lo, b.boxes.lo) and np.array_equal(a.boxes.hi, b.boxes.hi)
     # RCSE knows nothing about x(0): its set is the prior frame
     assert isinstance(res.rcse.x[0], Interval) and bool(np.all(res.rcse.x[0] == jw.FRAME))
+
+
+def _same_domain(a, b) -> bool:
+    if isinstance(a, Subpaving):
+        return (isinstance(b, Subpaving) and np.array_equal(a.inside, b.inside)
+                and np.array_equal(a.boxes.lo, b.boxes.lo)
+                and np.array_equal(a.boxes.hi, b.boxes.hi))
+    return (isinstance(b, Interval) and np.array_equal(a.lo, b.lo, equal_nan=True)
+            and np.array_equal(a.hi, b.hi, equal_nan=True))
+
+
+@pytest.mark.parametrize("seed", range(2))
+def test_ncse_from_the_rcse_domains_is_the_ncse(seed):
+    """RCSE's domains are what FALL from x_K computes, so one CLIMB gives NCSE: on subpavings
+    (prior x0 only) the very same boxes, and on box batches a subset of NCSE's hulls."""
+    (run,) = random_runs(1, seed=200 + seed)
+    kw = dict(x0=jw.FRAME, domains="subpavings", eps=0.05)
+    causal, smoothed = rcse_ncse(jw.system(), run.y, **kw)
+    ref_c, ref_n = rcse(jw.system(), run.y, **kw), ncse(jw.system(), run.y, **kw)
+    for est, ref in ((causal, ref_c), (smoothed, ref_n)):
+        assert all(_same_domain(a, b) for a, b in zip(est.x, ref.x, strict=True))
+        assert all(_same_domain(a, b) for a, b in zip(est.y, ref.y, strict=True))
+    assert smoothed.time_s >= causal.time_s
+    assert rcse_ncse(jw.system(), run.y, smooth=False, **kw)[1] is None
+    runs = random_runs(30, seed=300 + seed)
+    y = Interval(np.stack([r.y.lo for r in runs]), np.stack([r.y.hi for r in runs]))
+    _, smoothed = rcse_ncse(jw.system(), y)
+    hull, ref = smoothed.hull(), ncse(jw.system(), y).hull()
+    assert bool(np.all(hull.is_subset(ref) | ref.is_empty()))
+    for i, r in enumerate(runs):
+        for k in range(11):
+            assert exact_inside(r.x[k], hull[i, k]), (i, k)
 
 
 def test_cse_smooths_and_ends_like_ncse_on_boxes():

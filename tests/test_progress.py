@@ -31,7 +31,11 @@ def test_the_estimators_bars_end_at_their_totals(monkeypatch, domains, eps):
 
     monkeypatch.setattr(discrete, "_progress", fake)
     jw.solve(jw.load(None), domains=domains, eps=eps, progress=True)
-    assert [d for d, _ in bars] == ["RCSE", "NCSE"]
+    kw = dict(x0=jw.FRAME if domains == "subpavings" else None, domains=domains, eps=eps,
+              progress=True)
+    discrete.rcse(jw.system(), jw.load(None), **kw)
+    discrete.ncse(jw.system(), jw.load(None), **kw)
+    assert [d for d, _ in bars] == ["RCSE + NCSE", "RCSE", "NCSE"]
     for desc, bar in bars:
         assert bar.n == bar.total, (desc, bar.n, bar.total)
 

@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..estimation import ChainEstimate, DiscreteSystem, ncse, rcse
+from ..estimation import ChainEstimate, DiscreteSystem, rcse_ncse
 from ..expr.functions import cos as _cos
 from ..expr.functions import sin as _sin
 from ..interval import Interval
@@ -105,10 +105,12 @@ class Jaulin2001:
 
 def solve(y: Interval, *, domains: str = "subpavings", eps: float = 0.01,
           progress: bool = False) -> Jaulin2001:
-    """RCSE and NCSE on the measurement sets ``y`` (``(K, 1)``, or ``(..., K, 1)`` for boxes)."""
+    """RCSE and NCSE on the measurement sets ``y`` (``(K, 1)``, or ``(..., K, 1)`` for boxes):
+    NCSE continues from the RCSE's domains (:func:`boundest.estimation.rcse_ncse`)."""
     x0 = FRAME if domains == "subpavings" else None
-    kw = dict(x0=x0, domains=domains, eps=eps, progress=progress)
-    return Jaulin2001(rcse(system(), y, **kw), ncse(system(), y, **kw), domains, eps)
+    causal, smoothed = rcse_ncse(system(), y, x0=x0, domains=domains, eps=eps,
+                                 progress=progress)
+    return Jaulin2001(causal, smoothed, domains, eps)
 
 
 def _areas(d: Interval | Subpaving) -> tuple[int, float, float]:
