@@ -56,13 +56,14 @@ def subplots(nrows: int = 1, ncols: int = 1, *, figsize: tuple[float, float] | N
 PNG_COMPRESSION = 1
 
 
-def save_figure(fig: Any, out: str | Path, name: str, dpi: int = 120) -> Path:
-    """Lay out ``fig`` (unless it has its own layout engine), write it to ``out/name.png``
-    (creating the folder, zlib level :data:`PNG_COMPRESSION`), close it if pyplot made it, say
-    so."""
+def save_figure(fig: Any, out: str | Path, name: str, dpi: int = 120, tight: bool = True
+                ) -> Path:
+    """Lay out ``fig`` (``tight_layout``, unless it has its own layout engine or ``tight`` is
+    False: margins set by the caller), write it to ``out/name.png`` (creating the folder, zlib
+    level :data:`PNG_COMPRESSION`), close it if pyplot made it, say so."""
     folder = Path(out)
     folder.mkdir(parents=True, exist_ok=True)
-    if fig.get_layout_engine() is None:
+    if tight and fig.get_layout_engine() is None:
         fig.tight_layout()
     png = folder / f"{name}.png"
     fig.savefig(png, dpi=dpi, pil_kwargs={"compress_level": PNG_COMPRESSION})

@@ -8,6 +8,7 @@ import time
 from pathlib import Path
 
 from . import save_figure, subplots, write_json
+from .figures import FigureWorker
 
 
 def _summary(res, data) -> None:
@@ -54,6 +55,7 @@ def to_json(res, data, npz: Path | None) -> dict:
 
 
 def run(args: argparse.Namespace) -> int:
+    figures = FigureWorker(preload=("boundest.plot.auv", "boundest.scenarios.auv"))
     from ..scenarios import auv
     from ..scenarios.auv_data import load_auv
 
@@ -75,26 +77,48 @@ def run(args: argparse.Namespace) -> int:
         results.append(res)
     final = results[-1]
 
-    from ..plot.auv import plot_auv_depth, plot_auv_map, plot_auv_widths
+    for draw in (draw_map, draw_depth, draw_widths):  # the slowest first
+        figures.submit(draw, data, results, args.out)
+    if args.json:
+        npz = Path(args.json).with_suffix(".npz")
+        write_json(to_json(final, data, npz), args.json)
+    figures.finish()
+    return 0 if final.consistent else 1
 
+
+def draw_map(data, results, out: str) -> None:
+    """``auv_{mode}_map.png``: position boxes, GPS fixes (and mines, detections)."""
+    from ..plot.auv import plot_auv_map
+
+    final = results[-1]
     fig, ax = subplots(figsize=(10, 7.5))
     plot_auv_map(data, results, ax=ax)
     ax.set_title(f"AUV survey ({final.mode}): position boxes, GPS fixes"
                  + (", mines and detections" if final.mode == "slam" else ""))
-    save_figure(fig, args.out, f"auv_{final.mode}_map")
+    save_figure(fig, out, f"auv_{final.mode}_map")
+
+
+def draw_widths(data, results, out: str) -> None:
+    """``auv_{mode}_widths.png``: the width of the position box against time."""
+    from ..plot.auv import plot_auv_widths
+
+    final = results[-1]
     fig, ax = subplots(figsize=(10, 4))
     plot_auv_widths(data, results, ax=ax)
     ax.set_title("width of the position box against time"
                  + (": localization and SLAM" if final.mode == "slam" else ""))
-    save_figure(fig, args.out, f"auv_{final.mode}_widths")
+    save_figure(fig, out, f"auv_{final.mode}_widths")
+
+
+def draw_depth(data, results, out: str) -> None:
+    """``auv_{mode}_depth.png``: the depth profile."""
+    from ..plot.auv import plot_auv_depth
+
+    final = results[-1]
     fig, ax = subplots(figsize=(10, 3.5))
     plot_auv_depth(data, final, ax=ax)
     ax.set_title("depth profile")
-    save_figure(fig, args.out, f"auv_{final.mode}_depth")
-    if args.json:
-        npz = Path(args.json).with_suffix(".npz")
-        write_json(to_json(final, data, npz), args.json)
-    return 0 if final.consistent else 1
+    save_figure(fig, out, f"auv_{final.mode}_depth")
 
 
 def register(runs: argparse._SubParsersAction) -> None:

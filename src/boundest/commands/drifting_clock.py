@@ -5,12 +5,14 @@ from __future__ import annotations
 import argparse
 
 from . import save_figure, subplots, write_json
+from .figures import FigureWorker
 
 
 def run(args: argparse.Namespace) -> int:
+    figures = FigureWorker(preload=("boundest.plot.scenarios_tube",
+                                    "boundest.scenarios.drifting_clock"))
     import numpy as np
 
-    from ..plot.scenarios_tube import plot_clock_distance, plot_clock_drift
     from ..scenarios import drifting_clock as dc
 
     meas = dc.load(args.data)
@@ -36,17 +38,31 @@ def run(args: argparse.Namespace) -> int:
                   f"[t_{i + 1}] = [{res.t.lo[i]:.3f}, {res.t.hi[i]:.3f}] (from [h] alone "
                   f"[{res.t_initial.lo[i]:.3f}, {res.t_initial.hi[i]:.3f}])")
         truth = dc.ClockTruth() if args.data is None else None
-        for name, fn, title in (
-                ("clock_distance", plot_clock_distance,
-                 "ephemeris [y](.) and the measurements (Rohou et al. 2018, Fig. 11)"),
-                ("clock_drift", plot_clock_drift,
-                 "clock drift [h](.) and the times [t_i] (Rohou et al. 2018, Fig. 12)")):
-            fig, ax = subplots(figsize=(9, 5.5))
-            fn(res, truth=truth, ax=ax)
-            ax.set_title(title)
-            save_figure(fig, args.out, name)
+        for name in FIGURES:
+            figures.submit(draw_figure, name, res, truth, args.out)
     write_json(res.to_json(), args.json)
+    figures.finish()
     return 1 if res.empty else 0
+
+
+#: figure name -> (plotting function in ``boundest.plot.scenarios_tube``, title)
+FIGURES = {
+    "clock_distance": ("plot_clock_distance",
+                       "ephemeris [y](.) and the measurements (Rohou et al. 2018, Fig. 11)"),
+    "clock_drift": ("plot_clock_drift",
+                    "clock drift [h](.) and the times [t_i] (Rohou et al. 2018, Fig. 12)"),
+}
+
+
+def draw_figure(name: str, res, truth, out: str) -> None:
+    """``out/name.png``, one of :data:`FIGURES`."""
+    from ..plot import scenarios_tube
+
+    fn, title = FIGURES[name]
+    fig, ax = subplots(figsize=(9, 5.5))
+    getattr(scenarios_tube, fn)(res, truth=truth, ax=ax)
+    ax.set_title(title)
+    save_figure(fig, out, name)
 
 
 def register(runs: argparse._SubParsersAction) -> None:

@@ -7,6 +7,7 @@ import argparse
 import math
 
 from . import pyplot, save_figure, write_json
+from .figures import FigureWorker
 
 #: The choice of domains and what the other one costs (embedded data, in-process solve of RCSE
 #: and NCSE: subpavings at eps 0.01 0.56 s, boxes 0.18 s; non-causal hull of x(10)).
@@ -20,7 +21,7 @@ BOXES_LINE = ("mode: boxes, hull consistency on one box per k (the default subpa
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..plot import plot_set_sequence
+    figures = FigureWorker(preload=("boundest.plot", "boundest.scenarios.jaulin2001"))
     from ..scenarios import jaulin2001 as jw
 
     y = jw.load(args.data)
@@ -42,14 +43,24 @@ def run(args: argparse.Namespace) -> int:
     empty = any(math.isnan(s["hull_lo"][0]) for e in ("rcse", "ncse") for s in data[e]["sets"])
     if empty:
         print("proven INCONSISTENT: an empty set (the data contradict the model)")
+    figures.submit(draw_figure, res, args.out)
+    write_json(data, args.json)
+    figures.finish()
+    return 1 if empty else 0
+
+
+def draw_figure(res, out: str) -> None:
+    """``out/jaulin2001_{domains}.png``: every x(k), causal and non-causal (Fig. 7)."""
+    from ..plot import plot_set_sequence
+    from ..scenarios import jaulin2001 as jw
+
     pyplot()  # the file-only backend, before plot_set_sequence makes its figure
+    K = len(res.rcse.x) - 1
     fig = plot_set_sequence([res.rcse.x, res.ncse.x], ["causal (RCSE)", "non-causal (NCSE)"],
                             jw.FRAME)
     fig.suptitle(f"x(k), k = 0..{K}: causal and non-causal sets (Jaulin et al. 2001, Fig. 7);\n"
                  "each panel zoomed on the non-causal set (ticks differ)", fontsize=10)
-    save_figure(fig, args.out, f"jaulin2001_{domains}", dpi=110)
-    write_json(data, args.json)
-    return 1 if empty else 0
+    save_figure(fig, out, f"jaulin2001_{res.domains}", dpi=110)
 
 
 def _f(v: float) -> str:

@@ -5,12 +5,14 @@ from __future__ import annotations
 import argparse
 
 from . import save_figure, subplots, write_json
+from .figures import FigureWorker
 
 
 def run(args: argparse.Namespace) -> int:
+    figures = FigureWorker(preload=("boundest.plot.scenarios_tube",
+                                    "boundest.scenarios.range_only"))
     import numpy as np
 
-    from ..plot.scenarios_tube import plot_range_only_diagonal, plot_range_only_map
     from ..scenarios import range_only as ro
 
     meas = ro.load(args.data, args.beacons)
@@ -42,17 +44,32 @@ def run(args: argparse.Namespace) -> int:
                   f"(data [{meas.t.lo[i]:.2f}, {meas.t.hi[i]:.2f}]), "
                   f"[z_{i + 1}] = [{res.z.lo[i]:.3f}, {res.z.hi[i]:.3f}]")
         truth = ro.RobotTruth() if args.data is None else None
-        fig, ax = subplots(figsize=(9, 4))
-        plot_range_only_diagonal(res, ax=ax)
-        ax.set_title(f"position-box diagonal per iteration (Rohou et al. 2018, Fig. 8), "
-                     f"dt = {args.dt:g}")
-        save_figure(fig, args.out, "range_only_diagonal")
-        fig, ax = subplots(figsize=(9, 7))
-        plot_range_only_map(res, truth=truth, ax=ax)
-        ax.set_title("[x1](.) x [x2](.) among the beacons (Rohou et al. 2018, Fig. 9)")
-        save_figure(fig, args.out, "range_only_map")
+        figures.submit(draw_diagonal, res, args)
+        figures.submit(draw_map, res, truth, args)
     write_json(res.to_json(), args.json)
+    figures.finish()
     return 1 if res.empty else 0
+
+
+def draw_diagonal(res, args: argparse.Namespace) -> None:
+    """``range_only_diagonal.png``: the position-box diagonal per iteration (Fig. 8)."""
+    from ..plot.scenarios_tube import plot_range_only_diagonal
+
+    fig, ax = subplots(figsize=(9, 4))
+    plot_range_only_diagonal(res, ax=ax)
+    ax.set_title(f"position-box diagonal per iteration (Rohou et al. 2018, Fig. 8), "
+                 f"dt = {args.dt:g}")
+    save_figure(fig, args.out, "range_only_diagonal")
+
+
+def draw_map(res, truth, args: argparse.Namespace) -> None:
+    """``range_only_map.png``: the position tube among the beacons (Fig. 9)."""
+    from ..plot.scenarios_tube import plot_range_only_map
+
+    fig, ax = subplots(figsize=(9, 7))
+    plot_range_only_map(res, truth=truth, ax=ax)
+    ax.set_title("[x1](.) x [x2](.) among the beacons (Rohou et al. 2018, Fig. 9)")
+    save_figure(fig, args.out, "range_only_map")
 
 
 def register(runs: argparse._SubParsersAction) -> None:

@@ -5,13 +5,13 @@ from __future__ import annotations
 import argparse
 
 from . import save_figure, subplots, write_json
+from .figures import FigureWorker
 
 
 def run(args: argparse.Namespace) -> int:
+    figures = FigureWorker(preload=("boundest.plot", "boundest.scenarios.satellite"))
     import numpy as np
 
-    from ..interval import Interval
-    from ..plot import plot_boxes
     from ..scenarios import satellite as sat
 
     meas = sat.load(args.data, k_max=args.kmax)
@@ -44,24 +44,33 @@ def run(args: argparse.Namespace) -> int:
         w = res.x_hi - res.x_lo
         print("  mean width over k: " + ", ".join(f"x{i + 1} {np.mean(w[:, i]):.3f}"
                                                   for i in range(4)))
-        fig, ax = subplots(figsize=(6.5, 6))
-        plot_boxes(Interval._new(res.x_lo[:, 0], res.x_hi[:, 0]),
-                   Interval._new(res.x_lo[:, 1], res.x_hi[:, 1]), ax=ax,
-                   label="box [x1](k) x [x2](k), one per k")
-        ax.plot(0, 0, "o", color="tab:green", ms=10, label="earth")
-        ax.set_xlabel("x1 (length unit of the model, G M = 1)")
-        ax.set_ylabel("x2 (length unit of the model)")
-        ax.set_aspect("equal")
-        ax.set_title(f"[x1](k) x [x2](k), k = 0..{meas.k_max} (Jaulin 2002, Fig. 4)")
-        for k, dx in ((0, -12), (meas.k_max, -12)):
-            b = res.box(k)
-            ax.annotate(f"k = {k}", ((b.lo[0] + b.hi[0]) / 2, (b.lo[1] + b.hi[1]) / 2),
-                        xytext=(dx, 0), textcoords="offset points", ha="right", va="center",
-                        fontsize=9, arrowprops=dict(arrowstyle="-", color="0.3", lw=0.8))
-        ax.legend(loc="center", bbox_to_anchor=(0.55, 0.45), fontsize=8)
-        save_figure(fig, args.out, f"satellite_k{meas.k_max}")
+        figures.submit(draw_figure, res, meas.k_max, args.out)
     write_json(res.to_json(), args.json)
+    figures.finish()
     return 0 if res.consistent else 1
+
+
+def draw_figure(res, k_max: int, out: str) -> None:
+    """``out/satellite_k{k_max}.png``: the boxes of the position (Jaulin 2002, Fig. 4)."""
+    from ..interval import Interval
+    from ..plot import plot_boxes
+
+    fig, ax = subplots(figsize=(6.5, 6))
+    plot_boxes(Interval._new(res.x_lo[:, 0], res.x_hi[:, 0]),
+               Interval._new(res.x_lo[:, 1], res.x_hi[:, 1]), ax=ax,
+               label="box [x1](k) x [x2](k), one per k")
+    ax.plot(0, 0, "o", color="tab:green", ms=10, label="earth")
+    ax.set_xlabel("x1 (length unit of the model, G M = 1)")
+    ax.set_ylabel("x2 (length unit of the model)")
+    ax.set_aspect("equal")
+    ax.set_title(f"[x1](k) x [x2](k), k = 0..{k_max} (Jaulin 2002, Fig. 4)")
+    for k, dx in ((0, -12), (k_max, -12)):
+        b = res.box(k)
+        ax.annotate(f"k = {k}", ((b.lo[0] + b.hi[0]) / 2, (b.lo[1] + b.hi[1]) / 2),
+                    xytext=(dx, 0), textcoords="offset points", ha="right", va="center",
+                    fontsize=9, arrowprops=dict(arrowstyle="-", color="0.3", lw=0.8))
+    ax.legend(loc="center", bbox_to_anchor=(0.55, 0.45), fontsize=8)
+    save_figure(fig, out, f"satellite_k{k_max}")
 
 
 def register(runs: argparse._SubParsersAction) -> None:
