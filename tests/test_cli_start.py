@@ -74,3 +74,25 @@ def test_a_compiling_run_says_so_once_and_a_cached_run_does_not(tmp_path):
         errs.append([line for line in out.stderr.splitlines() if "compiling" in line])
     assert len(errs[0]) == 1 and "boundest solve" in errs[0][0] and "about" in errs[0][0]
     assert errs[1] == []
+
+
+CONSOLE = """
+import atexit, sys
+atexit.register(lambda: print("exit handler ran"))
+from boundest.cli import console
+sys.argv = ["boundest", "demo", "--out", {out!r}]
+console()
+print("not reached: console() exits")
+"""
+
+
+def test_the_console_script_runs_the_exit_handlers_and_flushes_its_output(tmp_path):
+    """``console`` skips the interpreter's teardown, not the exit handlers nor the output."""
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONUNBUFFERED"}  # buffered pipes
+    out = subprocess.run([sys.executable, "-c", CONSOLE.format(out=str(tmp_path))], env=env,
+                         capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr[-2000:]
+    lines = out.stdout.splitlines()
+    assert lines[-1] == "exit handler ran", lines[-3:]
+    assert any(ln.startswith("wrote ") for ln in lines) and "not reached" not in out.stdout
+    assert list(tmp_path.glob("*.png"))
