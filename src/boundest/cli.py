@@ -19,10 +19,11 @@ from . import __version__
 from .commands import SCENARIOS, save_figure, subplots, write_json
 
 #: Measured empty-cache first run of each command without the shipped kernel archive
-#: (``BOUNDEST_KERNEL_ARCHIVE=0``, ``benchmarks/bench_startup.py``, 2 cores at load 3 from
-#: other jobs), printed when a run starts compiling; with the archive nothing compiles.
-COMPILE_ESTIMATE_S = {"satellite": 34, "jaulin2001": 29, "range-only": 40,
-                      "drifting-clock": 28, "auv": 52, "pool": 130, "solve": 31, "demo": 13}
+#: (``BOUNDEST_KERNEL_ARCHIVE=0``, ``benchmarks/bench_startup.py``, a quiet 2-core machine,
+#: 2026-12-04; under load from other jobs it took up to 3x as long), printed when a run starts
+#: compiling; with the archive nothing compiles.
+COMPILE_ESTIMATE_S = {"satellite": 11, "jaulin2001": 8, "range-only": 14,
+                      "drifting-clock": 10, "auv": 14, "pool": 38, "solve": 9, "demo": 4}
 
 
 def _demo(args: argparse.Namespace) -> int:
