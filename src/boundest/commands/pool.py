@@ -62,7 +62,6 @@ def _mean_widths(res) -> tuple:
 
 
 def run(args: argparse.Namespace) -> int:
-    figures = FigureWorker(preload=("boundest.plot.pool", "boundest.scenarios.pool"))
     import numpy as np
 
     from ..scenarios.pool import solve_pool
@@ -76,6 +75,7 @@ def run(args: argparse.Namespace) -> int:
         if args.monte_carlo is None:
             raise ValueError("--scheduler and --workers go with --monte-carlo N")
         return run_monte_carlo(args)
+    figures = FigureWorker(preload=("boundest.plot.pool", "boundest.scenarios.pool"))
     start = time.perf_counter()
     data = load_pool(args.data)
     read_s = time.perf_counter() - start
