@@ -9,6 +9,7 @@ import signal
 import subprocess
 import sys
 import textwrap
+import threading
 import time
 from pathlib import Path
 
@@ -83,6 +84,22 @@ def test_in_process_when_disabled(monkeypatch, capsys):
     w.finish()
     with pytest.raises(ValueError, match="in-process"):
         w.submit(fail, "in-process")
+
+
+def test_in_process_beside_other_threads(capsys):
+    """A fork would copy none of the other threads, and keep the locks they hold."""
+    stop = threading.Event()
+    t = threading.Thread(target=stop.wait, daemon=True)
+    t.start()
+    try:
+        w = FigureWorker()
+        assert not w.forked
+        w.submit(say, "here", 0.0)
+        w.finish()
+    finally:
+        stop.set()
+        t.join()
+    assert capsys.readouterr().out == f"here from {os.getpid()}\n"
 
 
 @linux

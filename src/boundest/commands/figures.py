@@ -9,9 +9,10 @@ command hands the worker module-level functions to call with its results
 (:meth:`FigureWorker.submit`, which pickles them; the heaviest first), goes on (JSON, tables)
 and collects what the children printed, in the order submitted (:meth:`FigureWorker.finish`);
 an error in a child is raised in the parent with its traceback. A child whose parent is gone
-exits. Elsewhere (no safe ``fork``: Windows and macOS), on one CPU, with
-``BOUNDEST_FIGURE_PROCESS=0``, or when no process can be started, the same functions run in
-the command's own process, one after the other.
+exits. Elsewhere (no safe ``fork``: Windows and macOS), on one CPU, in a process that runs
+other threads (a fork copies none of them, and whatever lock one holds stays held in the
+child: a notebook kernel, a Dask client), with ``BOUNDEST_FIGURE_PROCESS=0``, or when no process
+can be started, the same functions run in the command's own process, one after the other.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ import importlib
 import io
 import os
 import sys
+import threading
 import traceback
 from collections.abc import Callable, Iterable
 from typing import Any
@@ -110,6 +112,7 @@ class FigureWorker:
         cpus = os.cpu_count() or 1
         processes = 0 if cpus < 2 else min(processes, cpus)
         if not (processes > 0 and sys.platform.startswith("linux")
+                and threading.active_count() == 1
                 and os.environ.get("BOUNDEST_FIGURE_PROCESS", "1") != "0"):
             return
         import multiprocessing
