@@ -48,8 +48,16 @@ def _wait_gone(pids: list[int], timeout: float = 5.0) -> bool:
     return False
 
 
+@pytest.fixture
+def single_threaded(monkeypatch):
+    """Earlier tests may leave threads behind (Dask, tqdm's monitor), in which case the worker
+    draws in-process (:func:`test_in_process_beside_other_threads`); these tests are about
+    the children."""
+    monkeypatch.setattr(threading, "active_count", lambda: 1)
+
+
 @linux
-def test_jobs_run_in_two_children_and_print_in_submission_order(capsys):
+def test_jobs_run_in_two_children_and_print_in_submission_order(capsys, single_threaded):
     w = FigureWorker(processes=2)
     assert w.forked
     # the first job is the slowest: the others finish before it, and still print after it
@@ -65,7 +73,7 @@ def test_jobs_run_in_two_children_and_print_in_submission_order(capsys):
 
 
 @linux
-def test_a_failure_is_raised_in_the_parent_after_the_other_jobs(capsys):
+def test_a_failure_is_raised_in_the_parent_after_the_other_jobs(capsys, single_threaded):
     w = FigureWorker()
     w.submit(fail, "no such axis")
     w.submit(say, "after", 0.0)
@@ -128,3 +136,28 @@ def test_the_children_exit_when_the_command_is_killed(tmp_path):
     finally:
         if proc.poll() is None:
             proc.kill()
+
+
+def _children() -> set[int]:
+    pid = os.getpid()
+    return {int(c) for p in Path(f"/proc/{pid}/task").glob("*/children")
+            for c in p.read_text().split()}
+
+
+@linux
+def test_a_command_that_fails_leaves_no_figure_process(tmp_path, monkeypatch, single_threaded):
+    from boundest.cli import main
+    from boundest.commands import figures
+
+    started = []
+    monkeypatch.setattr(figures.FigureWorker, "__enter__",
+                        lambda self: started.append(self.forked) or self)
+
+    before = _children()
+    assert main(["run", "range-only", "--data", str(tmp_path / "missing.csv"), "--out",
+                 str(tmp_path)]) == 2
+    assert started == [True]  # the command did fork its figure processes
+    end = time.monotonic() + 5
+    while _children() - before and time.monotonic() < end:
+        time.sleep(0.05)
+    assert not _children() - before

@@ -55,7 +55,11 @@ def to_json(res, data, npz: Path | None) -> dict:
 
 
 def run(args: argparse.Namespace) -> int:
-    figures = FigureWorker(preload=("boundest.plot.auv", "boundest.scenarios.auv"))
+    with FigureWorker(preload=("boundest.plot.auv", "boundest.scenarios.auv")) as figures:
+        return _run(args, figures)
+
+
+def _run(args: argparse.Namespace, figures: FigureWorker) -> int:
     from ..scenarios import auv
     from ..scenarios.auv_data import load_auv
 

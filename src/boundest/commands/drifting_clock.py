@@ -9,8 +9,12 @@ from .figures import FigureWorker
 
 
 def run(args: argparse.Namespace) -> int:
-    figures = FigureWorker(preload=("boundest.plot.scenarios_tube",
-                                    "boundest.scenarios.drifting_clock"))
+    with FigureWorker(preload=("boundest.plot.scenarios_tube",
+                                    "boundest.scenarios.drifting_clock")) as figures:
+        return _run(args, figures)
+
+
+def _run(args: argparse.Namespace, figures: FigureWorker) -> int:
     import numpy as np
 
     from ..scenarios import drifting_clock as dc

@@ -165,27 +165,17 @@ class FigureWorker:
         try:
             while self._busy:
                 ready = wait([self._conns[i] for i in self._busy])
-                for i in list(self._busy):
-                    if self._conns[i] not in ready:
-                        continue
+                for i in [i for i in self._busy if self._conns[i] in ready]:
+                    job = self._busy.pop(i)
                     try:
-                        self._results[self._busy.pop(i)] = self._conns[i].recv()
-                    except EOFError:
-                        self._results[self._busy.pop(i)] = ("error", "", "the figure process "
-                                                            "died\n")
+                        self._results[job] = self._conns[i].recv()
+                    except EOFError:  # that child is gone: no more jobs for it
+                        self._results[job] = ("error", "", "the figure process died\n")
                         continue
                     self._idle.append(i)
                 self._dispatch()
-            for conn in self._conns:
-                with contextlib.suppress(OSError):
-                    conn.send(None)
         finally:
-            for conn in self._conns:
-                conn.close()
-            self._proc.join(timeout=5)
-            if self._proc.is_alive():
-                self._proc.terminate()
-            self._proc = None
+            self.close()
         failure = None
         for job in range(len(self._jobs)):
             status, out, err = self._results.get(job, ("error", "", "not run: the figure "
@@ -198,3 +188,24 @@ class FigureWorker:
         sys.stdout.flush()
         if failure is not None:
             raise FigureError(f"drawing a figure failed in a figure process:\n{failure}")
+
+    def close(self) -> None:
+        """Stop the children (a job still running is dropped); :meth:`finish` calls it, and so
+        does leaving a ``with`` block, so that a command that fails leaves no child behind."""
+        if self._proc is None:
+            return
+        for conn in self._conns:
+            with contextlib.suppress(OSError):
+                conn.send(None)
+            conn.close()
+        self._proc.join(timeout=1)
+        if self._proc.is_alive():  # still drawing: the second child follows it out
+            self._proc.terminate()
+            self._proc.join(timeout=1)
+        self._proc = None
+
+    def __enter__(self) -> FigureWorker:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

@@ -21,7 +21,11 @@ BOXES_LINE = ("mode: boxes, hull consistency on one box per k (the default subpa
 
 
 def run(args: argparse.Namespace) -> int:
-    figures = FigureWorker(preload=("boundest.plot", "boundest.scenarios.jaulin2001"))
+    with FigureWorker(preload=("boundest.plot", "boundest.scenarios.jaulin2001")) as figures:
+        return _run(args, figures)
+
+
+def _run(args: argparse.Namespace, figures: FigureWorker) -> int:
     from ..scenarios import jaulin2001 as jw
 
     y = jw.load(args.data)

@@ -62,11 +62,6 @@ def _mean_widths(res) -> tuple:
 
 
 def run(args: argparse.Namespace) -> int:
-    import numpy as np
-
-    from ..scenarios.pool import solve_pool
-    from ..scenarios.pool_data import binomial_bound, load_pool
-
     if args.q < 0 or args.m < 1:
         raise ValueError(f"need --q >= 0 and --m >= 1, got --q {args.q} --m {args.m}")
     if args.monte_carlo is not None or args.scheduler or args.workers is not None:
@@ -75,7 +70,16 @@ def run(args: argparse.Namespace) -> int:
         if args.monte_carlo is None:
             raise ValueError("--scheduler and --workers go with --monte-carlo N")
         return run_monte_carlo(args)
-    figures = FigureWorker(preload=("boundest.plot.pool", "boundest.scenarios.pool"))
+    with FigureWorker(preload=("boundest.plot.pool", "boundest.scenarios.pool")) as figures:
+        return _run(args, figures)
+
+
+def _run(args: argparse.Namespace, figures: FigureWorker) -> int:
+    import numpy as np
+
+    from ..scenarios.pool import solve_pool
+    from ..scenarios.pool_data import binomial_bound, load_pool
+
     start = time.perf_counter()
     data = load_pool(args.data)
     read_s = time.perf_counter() - start

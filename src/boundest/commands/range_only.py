@@ -9,8 +9,12 @@ from .figures import FigureWorker
 
 
 def run(args: argparse.Namespace) -> int:
-    figures = FigureWorker(preload=("boundest.plot.scenarios_tube",
-                                    "boundest.scenarios.range_only"))
+    with FigureWorker(preload=("boundest.plot.scenarios_tube",
+                                    "boundest.scenarios.range_only")) as figures:
+        return _run(args, figures)
+
+
+def _run(args: argparse.Namespace, figures: FigureWorker) -> int:
     import numpy as np
 
     from ..scenarios import range_only as ro

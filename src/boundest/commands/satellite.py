@@ -9,7 +9,11 @@ from .figures import FigureWorker
 
 
 def run(args: argparse.Namespace) -> int:
-    figures = FigureWorker(preload=("boundest.plot", "boundest.scenarios.satellite"))
+    with FigureWorker(preload=("boundest.plot", "boundest.scenarios.satellite")) as figures:
+        return _run(args, figures)
+
+
+def _run(args: argparse.Namespace, figures: FigureWorker) -> int:
     import numpy as np
 
     from ..scenarios import satellite as sat
