@@ -32,10 +32,11 @@ from boundest.ctc import (
     shrink_ratio,
 )
 from boundest.expr import Const, Model, Op, Var, parse_model
-from boundest.expr.parser import decimal_interval
 from boundest.expr.tape import compile_model
 
 from .strategies import ulps_apart
+
+decimal_interval = Interval.from_decimal  # the public entry of boundest.interval.decimal
 
 MAX = 1.7976931348623157e308
 INF = math.inf

@@ -31,8 +31,9 @@ from boundest.expr import (
     variables,
 )
 from boundest.expr.nodes import BINARY, UNARY
-from boundest.expr.parser import decimal_interval
 from boundest.expr.tape import OPS, compile_model
+
+decimal_interval = Interval.from_decimal  # the public entry of boundest.interval.decimal
 
 MAX = 1.7976931348623157e308
 x, y, z = Var("x"), Var("y"), Var("z")
@@ -538,6 +539,24 @@ def test_decimal_interval_out_of_range():
     assert (float(iv.lo), float(iv.hi)) == (-math.inf, -MAX)
     with pytest.raises(ValueError, match="not a decimal number"):
         decimal_interval("1e")
+
+
+def test_decimal_arrays_keep_their_shape_and_each_bound():
+    texts = [["0.1", "2", "-1e400"], ["0", "-0.3", "123456789012345678901234567890.5"]]
+    iv = Interval.from_decimal(texts)
+    assert iv.shape == (2, 3)
+    for i, row in enumerate(texts):
+        for j, t in enumerate(row):
+            one = Interval.from_decimal(t)
+            assert (float(iv.lo[i, j]), float(iv.hi[i, j])) == (float(one.lo), float(one.hi))
+            exact = Fraction(t)  # exact rational value of the literal
+            lo, hi = Fraction(float(one.lo)) if math.isfinite(one.lo) else None, \
+                Fraction(float(one.hi)) if math.isfinite(one.hi) else None
+            assert (lo is None or lo <= exact) and (hi is None or exact <= hi), t
+    with pytest.raises(ValueError, match="takes strings"):
+        Interval.from_decimal(["0.1", 0.2])
+    with pytest.raises(ValueError, match="not a decimal number"):
+        Interval.from_decimal(["0.1", "one"])
 
 
 # -------------------------------------------------------------------------------------------

@@ -163,6 +163,44 @@ class Interval:
         hi = np.stack([np.broadcast_to(v.hi, shape) for v in ivs], axis=axis)
         return cls._new(lo, hi)
 
+    @classmethod
+    def from_decimal(cls, text: str | Sequence | NDArray) -> Interval:
+        """The tightest intervals containing numbers written in decimal: ``"0.1"``, which no
+        float equals, gives the two floats around it; a string that a float represents
+        exactly (``"0.5"``, ``"3"``) a degenerate interval. A nested sequence or array of
+        strings gives an Interval of its shape.
+
+        The comparison with the floats is exact (rational arithmetic on up to 40 significant
+        digits, then digit by digit), whatever the length of the literal. Beyond the float
+        range the enclosure is ``[MAX, +oo]`` (or its negative). ``Interval(0.1)`` is the
+        float nearest 0.1 instead, which does not contain it.
+
+        Raises
+        ------
+        ValueError
+            When a string is not a decimal literal (``"1e-3"``, ``"-.5"``, ``"+2."`` are).
+
+        Examples
+        --------
+        >>> x = Interval.from_decimal("0.1")
+        >>> float(x.lo) < 0.1 == float(x.hi), float(x.width()) > 0
+        (True, True)
+        >>> Interval.from_decimal(["0.5", "-3"])
+        Interval([[0.5, 0.5], [-3.0, -3.0]])
+        """
+        from .decimal import decimal_bounds
+
+        if isinstance(text, str):
+            lo, hi, _ = decimal_bounds(text)
+            return cls._new(np.asarray(lo), np.asarray(hi))
+        texts = np.asarray(text, dtype=object)
+        lo, hi = np.empty(texts.shape), np.empty(texts.shape)
+        for i, t in enumerate(texts.flat):
+            if not isinstance(t, str):
+                raise ValueError(f"Interval.from_decimal takes strings, got {t!r}")
+            lo.flat[i], hi.flat[i], _ = decimal_bounds(t)
+        return cls._new(lo, hi)
+
     def to_bounds(self) -> NDArray[np.float64]:
         """The bounds as one array of shape ``(..., 2)``."""
         return np.stack([self.lo, self.hi], axis=-1)
