@@ -25,9 +25,9 @@ def say(text: str, delay: float) -> None:
     print(f"{text} from {os.getpid()}")
 
 
-def fail(text: str) -> None:
+def fail(text: str, kind: type[Exception] = RuntimeError) -> None:
     print("before the failure")
-    raise ValueError(text)
+    raise kind(text)
 
 
 def _gone(pid: int) -> bool:
@@ -83,6 +83,17 @@ def test_a_failure_is_raised_in_the_parent_after_the_other_jobs(capsys, single_t
     assert "before the failure" in out and "after from" in out
 
 
+@linux
+@pytest.mark.parametrize("kind", [OSError, ValueError])
+def test_bad_input_in_a_child_is_raised_as_it_is(kind, single_threaded):
+    """An --out that cannot be written gives the command's one-line error, not a traceback."""
+    w = FigureWorker()
+    w.submit(fail, "cannot write out/x.png", kind)
+    with pytest.raises(kind, match="cannot write") as info:
+        w.finish()
+    assert not isinstance(info.value, FigureError)
+
+
 def test_in_process_when_disabled(monkeypatch, capsys):
     monkeypatch.setenv("BOUNDEST_FIGURE_PROCESS", "0")
     w = FigureWorker()
@@ -90,7 +101,7 @@ def test_in_process_when_disabled(monkeypatch, capsys):
     w.submit(say, "here", 0.0)  # at once, in this process
     assert capsys.readouterr().out == f"here from {os.getpid()}\n"
     w.finish()
-    with pytest.raises(ValueError, match="in-process"):
+    with pytest.raises(RuntimeError, match="in-process"):
         w.submit(fail, "in-process")
 
 
@@ -161,3 +172,14 @@ def test_a_command_that_fails_leaves_no_figure_process(tmp_path, monkeypatch, si
     while _children() - before and time.monotonic() < end:
         time.sleep(0.05)
     assert not _children() - before
+
+
+@linux
+def test_an_out_folder_that_is_a_file_is_one_line_of_error(tmp_path, capsys, single_threaded):
+    from boundest.cli import main
+
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    assert main(["run", "drifting-clock", "--out", str(blocker / "figs")]) == 2
+    err = capsys.readouterr().err
+    assert "boundest: error:" in err and "Traceback" not in err

@@ -21,6 +21,7 @@ import contextlib
 import importlib
 import io
 import os
+import pickle
 import sys
 import threading
 import traceback
@@ -84,9 +85,14 @@ def _loop(conn: Any, parent: int) -> None:
             func, args = job
             with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
                 func(*args)
-            conn.send(("ok", out.getvalue(), err.getvalue()))
-        except BaseException:
-            conn.send(("error", out.getvalue(), err.getvalue() + traceback.format_exc()))
+            conn.send(("ok", out.getvalue(), err.getvalue(), None))
+        except BaseException as exc:
+            tb = traceback.format_exc()
+            try:  # the exception itself, so that the parent can raise it as it is
+                pickle.dumps(exc)
+            except Exception:  # one that does not pickle: the traceback alone
+                exc = None
+            conn.send(("error", out.getvalue(), err.getvalue() + tb, exc))
 
 
 class FigureWorker:
@@ -108,7 +114,7 @@ class FigureWorker:
         self._jobs: list[tuple[Callable[..., Any], tuple]] = []
         self._idle: list[int] = []
         self._busy: dict[int, int] = {}  # connection -> job index
-        self._results: dict[int, tuple[str, str, str]] = {}
+        self._results: dict[int, tuple[str, str, str, BaseException | None]] = {}
         cpus = os.cpu_count() or 1
         processes = 0 if cpus < 2 else min(processes, cpus)
         if not (processes > 0 and sys.platform.startswith("linux")
@@ -157,7 +163,9 @@ class FigureWorker:
 
     def finish(self) -> None:
         """Wait for every submitted function, print what each printed (in the order
-        submitted), stop the children; raise :class:`FigureError` if one failed."""
+        submitted), stop the children. If one failed: its ``OSError`` or ``ValueError`` is
+        raised as it is (as the command would raise it in-process), any other failure as
+        :class:`FigureError` with the child's traceback."""
         if self._proc is None:
             return
         from multiprocessing.connection import wait
@@ -170,7 +178,7 @@ class FigureWorker:
                     try:
                         self._results[job] = self._conns[i].recv()
                     except EOFError:  # that child is gone: no more jobs for it
-                        self._results[job] = ("error", "", "the figure process died\n")
+                        self._results[job] = ("error", "", "the figure process died\n", None)
                         continue
                     self._idle.append(i)
                 self._dispatch()
@@ -178,16 +186,19 @@ class FigureWorker:
             self.close()
         failure = None
         for job in range(len(self._jobs)):
-            status, out, err = self._results.get(job, ("error", "", "not run: the figure "
-                                                       "processes died\n"))
+            status, out, err, exc = self._results.get(
+                job, ("error", "", "not run: the figure processes died\n", None))
             sys.stdout.write(out)
             if status == "ok":
                 sys.stderr.write(err)
             elif failure is None:
-                failure = err
+                failure = err, exc
         sys.stdout.flush()
         if failure is not None:
-            raise FigureError(f"drawing a figure failed in a figure process:\n{failure}")
+            err, exc = failure
+            if isinstance(exc, (OSError, ValueError)):  # bad input (an --out that is a file):
+                raise exc  # the one-line error the command gives in-process
+            raise FigureError(f"drawing a figure failed in a figure process:\n{err}")
 
     def close(self) -> None:
         """Stop the children (a job still running is dropped); :meth:`finish` calls it, and so
