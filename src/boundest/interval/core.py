@@ -13,6 +13,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .decimal import decimal_bounds
+
 __all__ = ["Interval", "IntervalVector", "as_interval", "hull", "intersect"]
 
 _MAX = float(np.finfo(np.float64).max)
@@ -183,13 +185,11 @@ class Interval:
         Examples
         --------
         >>> x = Interval.from_decimal("0.1")
-        >>> float(x.lo) < 0.1 == float(x.hi), float(x.width()) > 0
+        >>> float(x.hi) == 0.1, float(x.lo) < 0.1  # the double 0.1 lies above one tenth
         (True, True)
         >>> Interval.from_decimal(["0.5", "-3"])
         Interval([[0.5, 0.5], [-3.0, -3.0]])
         """
-        from .decimal import decimal_bounds
-
         if isinstance(text, str):
             lo, hi, _ = decimal_bounds(text)
             return cls._new(np.asarray(lo), np.asarray(hi))
