@@ -10,7 +10,7 @@ from .figures import FigureWorker
 
 def run(args: argparse.Namespace) -> int:
     with FigureWorker(preload=("boundest.plot.scenarios_tube",
-                                    "boundest.scenarios.drifting_clock")) as figures:
+                               "boundest.scenarios.drifting_clock")) as figures:
         return _run(args, figures)
 
 

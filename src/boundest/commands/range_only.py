@@ -10,7 +10,7 @@ from .figures import FigureWorker
 
 def run(args: argparse.Namespace) -> int:
     with FigureWorker(preload=("boundest.plot.scenarios_tube",
-                                    "boundest.scenarios.range_only")) as figures:
+                               "boundest.scenarios.range_only")) as figures:
         return _run(args, figures)
 
 
