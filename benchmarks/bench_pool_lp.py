@@ -221,6 +221,9 @@ class Window:
     def max_dropped(self, c: int, sign: float, budget: int) -> float:
         """``max sign * state_k[c]`` over every choice of at most ``budget`` dropped pings
         (module docstring, ``exact``)."""
+        if self.solver.highs is None:
+            raise SystemExit("the exact variant needs SciPy's bundled HiGHS bindings "
+                             "(scipy.optimize._highspy) for the multipliers")
         e = np.zeros(self.system.n_cols)
         e[self.tk + c] = -sign
         cache: dict[frozenset, float] = {}
