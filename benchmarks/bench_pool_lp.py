@@ -47,7 +47,7 @@ forward: a recursive observer with an LP step.
 Usage::
 
     .venv/bin/python benchmarks/bench_pool_lp.py [--seeds 1] [--steps 80:160]
-        [--variants oracle,bigm,groups1,groups2] [--exact-every 20] [--embedded]
+        [--variants box,oracle,bigm,groups1,groups2,exact] [--exact-every 20] [--embedded]
         [--out benchmarks/results/pool_lp.json]
 
 Needs SciPy (``pip install -e '.[lp]'``). JSON goes to stdout (and to ``--out``); progress to
