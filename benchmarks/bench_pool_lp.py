@@ -41,7 +41,7 @@ handled is what the variants compare:
   bound. Also run without feeding, on the plain observer's windows at every
   ``--exact-every``-th step, next to ``groups2`` on the same windows.
 
-With ``--feed`` (the default) the bounds replace the observer's box at ``k``, which it carries
+By default (``--no-feed`` turns it off) the bounds replace the observer's box at ``k``, which it carries
 forward: a recursive observer with an LP step.
 
 Usage::
