@@ -41,8 +41,8 @@ handled is what the variants compare:
   bound. Also run without feeding, on the plain observer's windows at every
   ``--exact-every``-th step, next to ``groups2`` on the same windows.
 
-By default (``--no-feed`` turns it off) the bounds replace the observer's box at ``k``, which it carries
-forward: a recursive observer with an LP step.
+By default (``--no-feed`` turns it off) the bounds replace the observer's box at ``k``, which
+it carries forward: a recursive observer with an LP step.
 
 Usage::
 
