@@ -4,8 +4,9 @@ observer.
 The recursive box observer of the pool robot (Jaulin's robust set-membership observer,
 ``scenarios.pool``) reaches 0.74 / 0.66 m (mean x / y widths at q = 8 on the embedded mission),
 and its smoothing is at its fixpoint there. ``bench_pool_exact.py`` proved that the exact causal
-set is far narrower (about 0.25 / 0.18 m). This script measures how much of that gap a
-**linear programme over the window** recovers, and what the q-relaxation costs inside it.
+set is at least 0.26-0.31 / 0.17-0.20 m wide (witnesses: a lower bound, whose search looked
+converged). This script measures how much of the gap a **linear programme over the window**
+recovers, and what the q-relaxation costs inside it.
 
 The programme, at ping ``k`` (window ``j = k - m + 1 .. k``), built from the observer's smoothed
 window boxes ``S_j`` after its update ``k``:
