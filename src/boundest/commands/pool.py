@@ -223,9 +223,9 @@ def to_json(data, res, args, p_full: float, rows: list[dict], per_update=None) -
 
 def _mode_line(sweeps: int, paved: bool) -> str:
     """Which contraction this run used, and what the other choices cost (the measured table of
-    docs/scenarios/pool.md: embedded mission, q = 8, in-process warm times)."""
+    the README: embedded mission, q = 8, in-process warm times, 2026-12-04)."""
     table = ("in-process, quiet machine: --sweeps 0: 0.02 s, 0.96 x 0.87 m; default --sweeps 1: "
-             "0.9 s, 0.74 x 0.66 m; --sweeps 0 --paving-heading 0.05: 5.5 s, 0.61 x 0.47 m")
+             "0.9 s, 0.74 x 0.66 m; --sweeps 0 --paving-heading 0.05: 4.4 s, 0.61 x 0.48 m")
     if paved:
         return f"mode: paving, the tightest and slowest (on the embedded mission {table})"
     if sweeps == 0:
