@@ -89,11 +89,12 @@ def test_pool_online_paved_window_only_run(tmp_path):
     js = tmp_path / "p.json"
     buf = io.StringIO()
     with contextlib.redirect_stdout(buf):
-        rc = main(["run", "pool", "--online", "--window-only", "--paving-heading", "0.3",
+        rc = main(["run", "pool", "--online", "--window-only", "--paving", "2",
                    "--m", "30", "--out", str(tmp_path), "--json", str(js)])
     assert rc == 0
     data = json.loads(js.read_text(), parse_constant=_refuse)
-    assert data["observer"] == "window" and data["paving_heading"] == 0.3
+    assert data["observer"] == "window" and data["paving"] == 2
+    assert data["paving_heading"] is None and data["heading_slices"] is None
     assert data["online"]["updates"] == 405 and data["online"]["median_s"] > 0
     assert "P(x_k in X_k) >=" in data["guarantee"]  # the pure window observer's guarantee
     assert all(s["cells"] >= 1 for s in data["steps"] if not s["empty"])
@@ -101,8 +102,19 @@ def test_pool_online_paved_window_only_run(tmp_path):
 
 
 @pytest.mark.parametrize("bad", [["--paving", "0"], ["--paving-heading", "-0.1"],
-                                 ["--sweeps", "-1"]])
+                                 ["--sweeps", "-1"],
+                                 ["--heading-slices", "0", "--paving-heading", "0.1"],
+                                 ["--window-only", "--paving-heading", "0.1"],
+                                 ["--heading-slices", "8"]])
 def test_pool_bad_options(tmp_path, capsys, bad):
     assert main(["run", "pool", *bad, "--out", str(tmp_path)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and bad[0].strip("-").replace("-", "_").split("_")[0] in err[0]
+
+
+def test_pool_help_states_the_default_slices(capsys):
+    from boundest.scenarios.pool import DEFAULT_SLICES
+
+    with pytest.raises(SystemExit):
+        main(["run", "pool", "--help"])
+    assert f"(default {DEFAULT_SLICES};" in " ".join(capsys.readouterr().out.split())

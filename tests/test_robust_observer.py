@@ -48,11 +48,16 @@ def _inside(res, truth) -> np.ndarray:
     return ((res.boxes.lo <= truth.states) & (truth.states <= res.boxes.hi)).all(-1)
 
 
-@pytest.mark.slow  # about 20 s for the four cases
-@pytest.mark.parametrize(("q", "sweeps", "n"), [(4, 0, 48), (8, 0, 48), (4, 1, 6), (8, 1, 6)])
-def test_truth_kept_while_windows_hold_at_most_q_outliers(q, sweeps, n):
+@pytest.mark.slow  # about 35 s for the six cases
+@pytest.mark.parametrize(("q", "sweeps", "n", "heading"),
+                         [(4, 0, 48, None), (8, 0, 48, None), (4, 1, 6, None), (8, 1, 6, None),
+                          (4, 0, 12, 0.05), (8, 0, 12, 0.02)])
+def test_truth_kept_while_windows_hold_at_most_q_outliers(q, sweeps, n, heading):
     data, truth = missions(11, n)
-    res = solve_pool(data, q=q, m=80, sweeps=sweeps)
+    # heading slices: cut, dropped when empty and merged beyond 8 (merges at most steps)
+    res = solve_pool(data, q=q, m=80, sweeps=sweeps, paving_heading=heading, heading_slices=8)
+    if heading is not None:
+        assert res.cells.max() == 8 and res.cells.min() >= 1
     inside = _inside(res, truth)
     ok = _guaranteed(truth.outlier, res.empty, 80, q)
     assert ok.sum() > 80 * n  # of n x 406 steps
@@ -80,24 +85,27 @@ def test_restart_recovers_from_a_window_with_too_many_outliers():
     # q = 1 is too small for p = 0.05 and m = 80: the set empties, is reported, and the
     # observer restarts from the window alone; the heading stays bounded (the open-loop prior)
     data, truth = missions(3, 3)
-    res = solve_pool(data, q=1, m=80, sweeps=0)
-    assert res.empty.any()
-    assert np.isfinite(res.boxes.lo).all() and np.isfinite(res.boxes.hi).all()
-    inside = _inside(res, truth)
-    ok = _guaranteed(truth.outlier, res.empty, 80, 1)
-    assert inside[ok].all()
+    for heading in (None, 0.05):  # heading slices: restarts when every slice is empty
+        res = solve_pool(data, q=1, m=80, sweeps=0, paving_heading=heading, heading_slices=4)
+        assert res.empty.any()
+        assert np.isfinite(res.boxes.lo).all() and np.isfinite(res.boxes.hi).all()
+        inside = _inside(res, truth)
+        ok = _guaranteed(truth.outlier, res.empty, 80, 1)
+        assert inside[ok].all()
 
 
-def test_online_updates_are_the_offline_run():
+@pytest.mark.parametrize("kw", [{}, {"sweeps": 0, "paving_heading": 0.05, "heading_slices": 8}])
+def test_online_updates_are_the_offline_run(kw):
     data = load_pool()
-    off = solve_pool(data, q=8, m=80)
-    obs = PoolObserver(data, q=8, m=80)
+    off = solve_pool(data, q=8, m=80, **kw)
+    obs = PoolObserver(data, q=8, m=80, **kw)
     for k in range(60):
         u = data.inputs[k - 1] if k else None
         box, rejected, empty = obs.update(u, float(data.alpha[k]), data.ranges[k])
         assert np.array_equal(box.lo, off.boxes.lo[k]) and np.array_equal(box.hi,
                                                                            off.boxes.hi[k])
         assert rejected == off.rejected[k] and empty == off.empty[k]
+        assert obs.cells_kept == off.cells[k]
     with pytest.raises(ValueError, match="input box"):
         obs.update(None, 0.0, data.ranges[60])
 
@@ -123,6 +131,11 @@ def test_paving_keeps_the_truth_and_tightens():
     for bad in ({"paving": 0.0}, {"paving_heading": -1.0}, {"paving": float("nan")}):
         with pytest.raises(ValueError, match="paving"):
             solve_pool(data, **bad)
+    for bad in (0, 2.5, True):
+        with pytest.raises(ValueError, match="heading_slices"):
+            solve_pool(data, paving_heading=0.1, heading_slices=bad)
+    with pytest.raises(ValueError, match="recursive observer"):
+        solve_pool(data, paving_heading=0.1, carry=False)
 
 
 def test_embedded_mission():
@@ -133,6 +146,12 @@ def test_embedded_mission():
     assert np.all(np.isfinite(w)) and w[40:, :2].mean() < 1.0
     fast = solve_pool(data, q=8, m=80, sweeps=0)
     assert w[:, :2].mean() < fast.widths()[:, :2].mean()  # smoothing inside the window pays
+    # heading slices that carry their own past pay more, and lie in the hull they make
+    sliced = solve_pool(data, q=8, m=80, sweeps=0, paving_heading=0.05, heading_slices=8)
+    assert sliced.widths()[:, :2].mean() < w[:, :2].mean()
+    cells, kept = sliced.paving, np.arange(sliced.paving.shape[-2]) < sliced.cells[:, None]
+    assert (cells.lo[kept] >= sliced.boxes.lo[:, None].repeat(cells.shape[-2], 1)[kept]).all()
+    assert (cells.hi[kept] <= sliced.boxes.hi[:, None].repeat(cells.shape[-2], 1)[kept]).all()
     # fewer outliers allowed than the data hold: the set empties, is reported, and restarts
     strict = solve_pool(data, q=2, m=80)
     assert strict.empty.any() and np.isfinite(strict.boxes.lo).all()

@@ -64,6 +64,8 @@ def _mean_widths(res) -> tuple:
 def run(args: argparse.Namespace) -> int:
     if args.q < 0 or args.m < 1:
         raise ValueError(f"need --q >= 0 and --m >= 1, got --q {args.q} --m {args.m}")
+    if args.heading_slices is not None and args.paving_heading is None:
+        raise ValueError("--heading-slices N goes with --paving-heading RAD")
     if args.monte_carlo is not None or args.scheduler or args.workers is not None:
         from .pool_mc import run_monte_carlo
 
@@ -89,7 +91,8 @@ def _run(args: argparse.Namespace, figures: FigureWorker) -> int:
     if args.sweeps is None:
         args.sweeps = 1
     kw = {"q": args.q, "m": args.m, "sweeps": args.sweeps, "carry": not args.window_only,
-          "paving": args.paving, "paving_heading": args.paving_heading}
+          "paving": args.paving, "paving_heading": args.paving_heading,
+          **({} if args.heading_slices is None else {"heading_slices": args.heading_slices})}
     paved = args.paving is not None or args.paving_heading is not None
     what = ("pure window observer" if args.window_only else "recursive observer") + (
         f", {args.sweeps} smoothing round(s) per ping" if args.sweeps else ", no smoothing") + (
@@ -118,7 +121,8 @@ def _run(args: argparse.Namespace, figures: FigureWorker) -> int:
              f" ({len(per_update)} online updates: median {np.median(per_update) * 1e3:.2f} ms,"
              f" max {np.max(per_update) * 1e3:.2f} ms)"))
     if res.eps:
-        print(f"paving ({_sides(res.eps)}): {res.cells.mean():.1f} cells kept per step on "
+        what = "heading slices" if res.eps[1] is not None else "cells"
+        print(f"paving ({_sides(res.eps)}): {res.cells.mean():.1f} {what} kept per step on "
               "average")
     print("  " + _mode_line(args.sweeps, paved))
     rows = table_rows(data, res)
@@ -213,7 +217,10 @@ def to_json(data, res, args, p_full: float, rows: list[dict], per_update=None) -
             "dt": data.dt, "p_outlier": data.p_outlier, "q": args.q, "m": args.m,
             "observer": "window" if args.window_only else "recursive",
             "sweeps": args.sweeps, "paving": args.paving,
-            "paving_heading": args.paving_heading, "online": online,
+            "paving_heading": args.paving_heading,
+            "heading_slices": (None if args.paving_heading is None else
+                               kw_slices(args)),
+            "online": online,
             "window_probability": p_full,
             "guarantee": GUARANTEE[not args.window_only].format(m=args.m, q=args.q),
             "width_mean": w, "width_mean_steps": nw,
@@ -233,10 +240,17 @@ def _mode_line(sweeps: int, paved: bool) -> str:
     return f"mode: smoothing inside the window ({table})"
 
 
+def kw_slices(args: argparse.Namespace) -> int:
+    """The most heading slices this run keeps (``--heading-slices``, else the default)."""
+    from ..scenarios.pool import DEFAULT_SLICES
+
+    return DEFAULT_SLICES if args.heading_slices is None else args.heading_slices
+
+
 def _sides(eps) -> str:
     xy, th = eps
     return ", ".join(([f"(x, y) cells of {xy:g} m"] if xy else [])
-                     + ([f"heading slices of {th:g} rad"] if th else []))
+                     + ([f"heading slices of at most {th:g} rad"] if th else []))
 
 
 def _online(data, kw: dict):
@@ -281,8 +295,12 @@ def register(runs: argparse._SubParsersAction) -> None:
                    help="pave (x, y) of each set into cells of side EPS metres and keep the "
                    "hull of the cells whose window is consistent (tighter, slower)")
     p.add_argument("--paving-heading", type=float, metavar="RAD",
-                   help="also cut the heading into slices of RAD radians (what pays most: "
-                   "e.g. 0.05)")
+                   help="keep the set as heading slices, each with its own window, cut in two "
+                   "when wider than RAD radians (what pays most: e.g. 0.01; recursive "
+                   "observer only)")
+    p.add_argument("--heading-slices", type=int, metavar="N",
+                   help="most heading slices kept with --paving-heading (default 32; beyond "
+                   "it neighbours merge)")
     p.add_argument("--window-only", action="store_true",
                    help="the pure window observer: each set from the open-loop prior and the "
                    "window's pings alone (its per-step guarantee is the binomial bound)")

@@ -118,8 +118,8 @@ def plot_pool_snapshot(data: PoolData, res: PoolResult, k: int,
     if res.paving is not None and res.cells[k]:
         cells = res.paving[k, : min(int(res.cells[k]), res.paving.shape[-2])]
         _rects(ax, cells.lo[:, :2], cells.hi[:, :2], facecolor="none", edgecolor=CELL, lw=0.6)
-        ax.plot([], [], "s", mfc="none", mec=CELL,
-                label=f"paving cells kept ({int(res.cells[k])})")
+        what = "heading slices" if res.eps and res.eps[1] is not None else "paving cells"
+        ax.plot([], [], "s", mfc="none", mec=CELL, label=f"{what} kept ({int(res.cells[k])})")
     return ax
 
 

@@ -25,13 +25,15 @@ from ..interval import Interval
 from . import pool_observer as po
 from .pool_data import PoolData, binomial_bound
 
-__all__ = ["DEFAULT_PASSES", "DEFAULT_SWEEPS", "PoolObserver", "PoolResult", "restart_box",
-           "solve_pool", "window_probabilities"]
+__all__ = ["DEFAULT_PASSES", "DEFAULT_SLICES", "DEFAULT_SWEEPS", "PoolObserver", "PoolResult",
+           "restart_box", "solve_pool", "window_probabilities"]
 
 #: Smoothing rounds per ping by default (see the benchmark: the widths it buys, its time).
 DEFAULT_SWEEPS = 1
 #: Passes of the ray-cast contractor per ping contraction.
 DEFAULT_PASSES = 1
+#: Most heading slices kept with ``paving_heading``.
+DEFAULT_SLICES = 32
 
 
 def _dt(dt: float) -> tuple[float, float]:
@@ -57,13 +59,24 @@ def window_probabilities(n: int, m: int, q: int, p: float) -> NDArray[np.float64
     return np.array([bound[min(k + 1, m)] for k in range(n)])
 
 
-def _eps(paving: float | None, heading: float | None) -> np.ndarray:
-    """The sides of the paving's cells in ``(x, y, theta)`` (``inf``: not cut)."""
+def _eps(paving: float | None, heading: float | None, slices: int, carry: bool) -> np.ndarray:
+    """The sides of the paving's cells in ``(x, y)`` and the widest heading slice
+    (``inf``: not cut)."""
     for name, v in (("paving", paving), ("paving_heading", heading)):
         if v is not None and not (np.isfinite(v) and v > 0):
             raise ValueError(f"the {name} precision must be a positive number, got {v!r}")
+    if isinstance(slices, bool) or not isinstance(slices, (int, np.integer)) or slices < 1:
+        raise ValueError(f"heading_slices must be a whole number >= 1, got {slices!r}")
+    if heading is not None and not carry:
+        raise ValueError("heading slices (--paving-heading) carry their own past: they need "
+                         "the recursive observer, not the pure window observer "
+                         "(--window-only, carry=False)")
     xy = np.inf if paving is None else float(paving)
     return np.array([xy, xy, np.inf if heading is None else float(heading)])
+
+
+def _slices(eps: np.ndarray, slices: int) -> int:
+    return int(slices) if eps[2] < np.inf else 1
 
 
 def _check(q: int, m: int, sweeps: int, passes: int, carry: bool) -> np.ndarray:
@@ -94,8 +107,12 @@ class PoolObserver:
         Pave ``(x, y)`` of each set into cells of this side [m] and keep the hull of the
         cells whose window is consistent (tighter, slower); None: boxes only.
     paving_heading : float, optional
-        Also cut ``theta`` into slices of this width [rad] (what pays most: on a thin heading
-        slice the pings pin the position).
+        Keep the set as a union of heading slices, each with its own window: a slice whose
+        heading is wider than this [rad] is cut in two before the next ping, a slice that
+        comes out empty is dropped (what pays most: on a thin heading slice the pings pin the
+        position, and each slice keeps its past states thin too); None: one box.
+    heading_slices : int
+        Most slices kept (beyond it, neighbours are merged); with ``paving_heading``.
 
     Examples
     --------
@@ -109,19 +126,20 @@ class PoolObserver:
 
     def __init__(self, data: PoolData, q: int = 8, m: int = 80, sweeps: int = DEFAULT_SWEEPS,
                  passes: int = DEFAULT_PASSES, carry: bool = True,
-                 paving: float | None = None, paving_heading: float | None = None) -> None:
+                 paving: float | None = None, paving_heading: float | None = None,
+                 heading_slices: int = DEFAULT_SLICES) -> None:
         self.par = _check(q, m, sweeps, passes, carry)
-        self.eps = _eps(paving, paving_heading)
+        self.eps = _eps(paving, paving_heading, heading_slices, carry)
         self.q, self.m = int(q), int(m)
         self.tapes = pack_tapes(data.map)
         self.x0 = data.x0
         self.restart = restart_box(data)
         self.h = _dt(data.dt)
-        self.ring = po.make_ring(self.m)
+        self.bank = po.make_bank(self.m, _slices(self.eps, heading_slices))
         self.work = po.make_work(self.m, self.tapes.lo0.size)
         self.cells = np.empty((0, 4)), np.empty((0, 4))
         self.paving = (paving, paving_heading) if np.isfinite(self.eps).any() else None
-        #: cells of the paving kept at the last update (0 without a paving)
+        #: cells of the paving (or heading slices) kept at the last update (0: neither)
         self.cells_kept = 0
         self.k = 0
 
@@ -141,10 +159,10 @@ class PoolObserver:
             ul = np.ascontiguousarray(u.lo, dtype=np.float64).reshape(2)
             uh = np.ascontiguousarray(u.hi, dtype=np.float64).reshape(2)
         xl, xh = np.empty(4), np.empty(4)
-        rej, empty, self.cells_kept = po.observer_update(
+        rej, empty, self.cells_kept = po.bank_update(
             self.k, ul, uh, float(alpha), float(d.lo), float(d.hi), self.par, self.eps,
             self.x0.lo, self.x0.hi, self.restart.lo, self.restart.hi, self.h[0], self.h[1],
-            self.tapes, self.ring, xl, xh, self.work, self.cells[0], self.cells[1])
+            self.tapes, self.bank, xl, xh, self.work, self.cells[0], self.cells[1])
         self.k += 1
         return Interval._new(xl, xh), int(rej), bool(empty)
 
@@ -167,11 +185,13 @@ class PoolResult:
         window is fine, the guarantee of the pure window observer; the recursive set at ``k``
         needs every window since the last restart to be (:mod:`.pool_observer`).
     cells : ndarray of int, shape (n,) or (M, n)
-        Cells of the ``(x, y)`` paving kept at each step (0 without a paving).
+        Heading slices kept at each step with ``paving_heading``; otherwise cells of the
+        ``(x, y)`` paving (0 without either).
     paving : Interval, shape (n, C, 4) or (M, n, C, 4), optional
-        The first ``C`` kept cells of each step (NaN rows beyond ``cells``).
+        The first ``C`` kept slices (or cells) of each step (NaN rows beyond ``cells``).
     eps : (float or None, float or None), optional
-        The paving's cell sides in ``(x, y)`` [m] and ``theta`` [rad] (None: not cut).
+        The paving's cell sides in ``(x, y)`` [m] and the widest heading slice [rad] (None:
+        not cut).
     """
 
     boxes: Interval
@@ -201,12 +221,14 @@ class PoolResult:
 
 def solve_pool(data: PoolData, q: int = 8, m: int = 80, sweeps: int = DEFAULT_SWEEPS,
                passes: int = DEFAULT_PASSES, carry: bool = True, paving: float | None = None,
-               paving_heading: float | None = None, keep_cells: int = 256) -> PoolResult:
+               paving_heading: float | None = None, heading_slices: int = DEFAULT_SLICES,
+               keep_cells: int = 256) -> PoolResult:
     """Run the observer over the whole mission (or every mission of a batch) offline: the
     same updates as :class:`PoolObserver` (parameters there), all in one compiled call.
-    With ``paving``, the first ``keep_cells`` kept cells of each step are returned."""
+    With ``paving`` or ``paving_heading``, the first ``keep_cells`` kept cells (or slices)
+    of each step are returned."""
     par = _check(q, m, sweeps, passes, carry)
-    eps = _eps(paving, paving_heading)
+    eps = _eps(paving, paving_heading, heading_slices, carry)
     paved = bool(np.isfinite(eps).any())
     n_cells = keep_cells if paved else 0
     start = time.perf_counter()
@@ -226,8 +248,8 @@ def solve_pool(data: PoolData, q: int = 8, m: int = 80, sweeps: int = DEFAULT_SW
     ch = np.full((n_m, data.n, n_cells, 4), np.nan)
     h = _dt(data.dt)
     alpha = np.ascontiguousarray(data.alpha, dtype=np.float64)
-    ring, work = po.make_ring(m), po.make_work(m, tapes.lo0.size)
-    args = (par, eps, data.x0.lo, data.x0.hi, restart.lo, restart.hi, h[0], h[1], tapes, ring,
+    bank, work = po.make_bank(m, _slices(eps, heading_slices)), po.make_work(m, tapes.lo0.size)
+    args = (par, eps, data.x0.lo, data.x0.hi, restart.lo, restart.hi, h[0], h[1], tapes, bank,
             work)
     # no mission: compiles (first run) or loads the kernel, outside the timed part
     po.run_missions(ul[:0], uh[:0], alpha, dl[:0], dh[:0], *args, xl[:0], xh[:0], rejected[:0],

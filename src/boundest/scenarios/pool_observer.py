@@ -24,6 +24,15 @@ One update:
    contracted again on its smaller ``S_j`` and carried to ``k`` through the ``S``; ``X_k`` is
    their q-relaxed intersection again. Each step is valid under *H*, so it keeps ``x_k``.
 
+**Heading slices** (:func:`bank_update`). The set may be a union of boxes, each with its own
+window (its own ``S_j`` and ``F_j``): before an update, every slice whose heading at ``k - 1``
+is wider than ``eps[2]`` is cut in two there; each slice is updated as above; a slice that
+comes out empty is dropped (under *H* the state is not in it); beyond the cap the two
+neighbouring slices whose hull is thinnest in heading are merged (the hull of their windows).
+A slice carries its own past: on a thin heading the pings pin the position, and the past
+states stay thin too, which cutting the hull again at every step would not keep. ``X_k`` is
+the hull of the slices; a ping is rejected when every slice rejects it.
+
 **Guarantee.** The recursive set (``carry=True``) holds ``x_k`` when every window since the
 start (or the last restart) held at most ``q`` outliers; the pure window set holds it when the
 window at ``k`` did, an event of probability ``P(at most q outliers among m pings)``. When
@@ -48,7 +57,7 @@ from ..interval import arith as ar
 from ..interval import trig as tr
 from ..interval.relaxed import covered_hull
 
-__all__ = ["observer_update", "run_missions"]
+__all__ = ["bank_update", "make_bank", "observer_update", "run_missions"]
 
 _njit = nb.njit(cache=True, error_model="numpy")
 _inline = nb.njit(cache=True, inline="always", error_model="numpy")
@@ -335,15 +344,14 @@ def _solve_window(SL, SH, UL, UH, AL, DL, DH, FL, FH, first, k, par, hl, hh, tp,
 @_njit
 def _pave(xl, xh, FL, FH, SL, SH, UL, UH, AL, DL, DH, first, k, par, eps, hl, hh, tp, work,
           cell_l, cell_h):
-    """``x ∩=`` the hull of the kept cells of a regular paving of its ``(x, y, theta)`` into
-    cells of sides at most ``eps`` (3 values, ``inf``: that component is not cut; at most
+    """``x ∩=`` the hull of the kept cells of a regular paving of its ``(x, y)`` into cells of
+    sides at most ``eps[0]``, ``eps[1]`` (``inf``: that component is not cut; at most
     ``MAX_SIDE`` cuts per component); returns the number of cells kept (0: the set is empty),
     the first ``cell_l.shape[0]`` of them written to ``cell_l``/``cell_h``.
 
-    Each cell (with the ``v`` of ``x``) replaces ``S_k`` in a copy of the window,
+    Each cell (with the ``theta``, ``v`` of ``x``) replaces ``S_k`` in a copy of the window,
     which is solved again (:func:`_smooth`, :func:`_solve_window`): on a small cell the pings
-    contract the heading, and on a thin heading slice the position, which the whole box
-    could not. A cell whose window comes out empty
+    contract the heading, which the whole box could not. A cell whose window comes out empty
     holds no state consistent with all but ``q`` pings. The window's states become the hull
     of the kept cells' windows.
     """
@@ -351,20 +359,20 @@ def _pave(xl, xh, FL, FH, SL, SH, UL, UH, AL, DL, DH, first, k, par, eps, hl, hh
     tmp_l, tmp_h, buf = work[1], work[2], work[3]
     SL2, SH2, FL2, FH2 = SL.copy(), SH.copy(), FL.copy(), FH.copy()
     WL, WH = np.full(SL.shape, np.inf), np.full(SL.shape, -np.inf)
-    n_side = np.empty(3, dtype=np.int64)
-    for c in range(3):
+    n_side = np.empty(2, dtype=np.int64)
+    for c in range(2):
         cuts = (xh[c] - xl[c]) / eps[c]  # inf: an unbounded side; 0: no paving of c
         n_side[c] = min(MAX_SIDE, max(1, int(np.ceil(cuts)))) if cuts < np.inf else 1
     bl, bh = np.empty(4), np.empty(4)
     kept = 0
-    for cell in range(n_side[0] * n_side[1] * n_side[2]):
-        idx = (cell % n_side[0], (cell // n_side[0]) % n_side[1], cell // (n_side[0] * n_side[1]))
-        for c in range(3):
+    for cell in range(n_side[0] * n_side[1]):
+        idx = (cell % n_side[0], cell // n_side[0])
+        for c in range(2):
             step = (xh[c] - xl[c]) / n_side[c]
             bl[c] = xl[c] + idx[c] * step if idx[c] > 0 else xl[c]
             bh[c] = xl[c] + (idx[c] + 1) * step if idx[c] < n_side[c] - 1 else xh[c]
-        bl[3:] = xl[3:]
-        bh[3:] = xh[3:]
+        bl[2:] = xl[2:]
+        bh[2:] = xh[2:]
         SL2[:] = SL
         SH2[:] = SH
         SL2[k % m] = bl
@@ -392,18 +400,18 @@ def _pave(xl, xh, FL, FH, SL, SH, UL, UH, AL, DL, DH, first, k, par, eps, hl, hh
 
 @_njit
 def observer_update(k, ul, uh, alpha, dl, dh, par, eps, x0l, x0h, rl, rh, hl, hh, tp, ring, xl,
-                    xh, work, cell_l, cell_h):
-    """Update ``k`` (the ping's index, from 0) of one mission, in place.
+                    xh, work, cell_l, cell_h, restart):
+    """Update ``k`` (the ping's index, from 0) of one mission (one slice), in place.
 
     ``u``: the input box applied since ping ``k - 1`` (ignored at ``k = 0``); ``par``: ``[m, q,
     sweeps, passes, carry]``; ``x0``, ``r``: the initial and the restart box (pool and speed
     bound); ``h`` = dt as an interval; ``ring = (SL, SH, PL, PH, FL, FH, UL, UH, AL, DL, DH)``
     (``m`` rows each); ``x``: the result ``X_k``; ``eps``: the sides of the cells of a paving
-    of ``(x, y, theta)`` (:func:`_pave`; all ``inf``: none), the kept cells into
-    ``cell_l``/``cell_h``. Returns
-    ``(rejected, empty, cells)``: the pings of the window whose ``F_j`` misses ``X_k``, whether
-    the set came out empty (then the observer restarted), and the cells kept (0 without
-    paving).
+    of ``(x, y)`` (:func:`_pave`; ``inf``: none; ``eps[2]`` is not read here), the kept cells
+    into ``cell_l``/``cell_h``. Returns ``(rejected, empty, cells)``: the pings of the window
+    whose ``F_j`` misses ``X_k``, whether the set came out empty, and the cells kept (0
+    without paving). An empty set restarts the observer (:func:`_conclude`) when
+    ``restart``; otherwise the update stops there, leaving the ring to be dropped.
     """
     SL, SH, PL, PH, FL, FH, UL, UH, AL, DL, DH = ring
     m, carry = par[M], par[CARRY]
@@ -454,12 +462,35 @@ def observer_update(k, ul, uh, alpha, dl, dh, par, eps, x0l, x0h, rl, rh, hl, hh
         ok = _solve_window(SL, SH, UL, UH, AL, DL, DH, FL, FH, first, k, par, hl, hh, tp, xl,
                            xh, work)
     cells = 0
-    if ok and eps.min() < np.inf:
+    if ok and min(eps[0], eps[1]) < np.inf:
         cells = _pave(xl, xh, FL, FH, SL, SH, UL, UH, AL, DL, DH, first, k, par, eps, hl, hh, tp,
                       work, cell_l, cell_h)
         ok = cells > 0
-    empty = not ok
-    if empty and carry:  # restart from the window alone
+    if not (ok or restart):
+        return 0, True, 0
+    return _conclude(ok, k, par, hl, hh, tp, ring, xl, xh, work), not ok, cells
+
+
+@_njit
+def _misses(FL, FH, js, xl, xh):
+    """Whether ping ``js``'s set ``F_js`` misses the box ``x`` (or is empty)."""
+    for c in range(4):
+        if not (FL[js, c] <= FH[js, c] and FL[js, c] <= xh[c] and FH[js, c] >= xl[c]):
+            return True
+    return False
+
+
+@_njit
+def _conclude(ok, k, par, hl, hh, tp, ring, xl, xh, work):
+    """The end of update ``k`` with ``X_k`` in ``x``, ``ok`` False when it came out empty:
+    then the recursive observer restarts from the window alone (and, if that is empty too,
+    takes ``P_k``); ``S_k = X_k``, and each ``F_j`` that meets ``X_k`` is cut to it. Returns
+    the pings whose ``F_j`` misses ``X_k``."""
+    SL, SH, PL, PH, FL, FH, UL, UH, AL, DL, DH = ring
+    m, carry = par[M], par[CARRY]
+    s = k % m
+    first = max(0, k - m + 1)
+    if not ok and carry:  # restart from the window alone
         for j in range(first, k + 1):
             SL[j % m, :] = PL[j % m]
             SH[j % m, :] = PH[j % m]
@@ -480,16 +511,11 @@ def observer_update(k, ul, uh, alpha, dl, dh, par, eps, x0l, x0h, rl, rh, hl, hh
     SH[s, :] = xh
     rejected = 0
     for j in range(first, k + 1):
-        js = j % m
-        miss = False
-        for c in range(4):
-            miss = miss or not (FL[js, c] <= FH[js, c] and FL[js, c] <= xh[c]
-                                and FH[js, c] >= xl[c])
-        if miss:
+        if _misses(FL, FH, j % m, xl, xh):
             rejected += 1
         else:
-            _meet(FL[js], FH[js], xl, xh)
-    return rejected, empty, cells
+            _meet(FL[j % m], FH[j % m], xl, xh)
+    return rejected
 
 
 def make_work(m: int, n_slots: int) -> tuple:
@@ -502,25 +528,147 @@ def make_work(m: int, n_slots: int) -> tuple:
             memo)
 
 
-def make_ring(m: int) -> tuple:
-    """The window's arrays of one mission (see :func:`observer_update`)."""
-    return (np.full((m, 4), np.nan), np.full((m, 4), np.nan), np.full((m, 4), np.nan),
-            np.full((m, 4), np.nan), np.full((m, 4), np.nan), np.full((m, 4), np.nan),
-            np.zeros((m, 2)), np.zeros((m, 2)), np.zeros(m), np.zeros(m), np.zeros(m))
+def make_bank(m: int, slices: int = 1) -> tuple:
+    """The arrays of one mission's set (see :func:`bank_update`): up to ``slices`` heading
+    slices (room for twice as many while they are cut), each with its window's ``S_j`` and
+    ``F_j`` (``m`` rows) and its box ``X_k``, the window's prior, inputs and pings (shared),
+    and the number of live slices."""
+    slots = 2 * slices
+    own = tuple(np.full((slots, m, 4), np.nan) for _ in range(4))
+    shared = (np.full((m, 4), np.nan), np.full((m, 4), np.nan), np.zeros((m, 2)),
+              np.zeros((m, 2)), np.zeros(m), np.zeros(m), np.zeros(m))
+    return own + shared + (np.full((slots, 4), np.nan), np.full((slots, 4), np.nan),
+                           np.zeros(1, dtype=np.int64))
 
 
 @_njit
-def run_missions(UL, UH, alpha, DLO, DHI, par, eps, x0l, x0h, rl, rh, hl, hh, tp, ring, work,
+def _hull_into(al, ah, bl, bh):
+    """``a`` = the hull of the boxes ``a`` and ``b``, row by row (a NaN row is empty)."""
+    for i in range(al.shape[0]):
+        for c in range(al.shape[1]):
+            if not bl[i, c] <= bh[i, c]:
+                continue
+            if al[i, c] <= ah[i, c]:
+                al[i, c] = min(al[i, c], bl[i, c])
+                ah[i, c] = max(ah[i, c], bh[i, c])
+            else:
+                al[i, c], ah[i, c] = bl[i, c], bh[i, c]
+
+
+@_njit
+def _move(bank, src, dst):
+    """Slice ``src`` copied into slot ``dst``."""
+    for a in (bank[0], bank[1], bank[2], bank[3]):
+        a[dst] = a[src]
+    bank[11][dst] = bank[11][src]
+    bank[12][dst] = bank[12][src]
+
+
+@_njit
+def _merge_thinnest(bank, n):
+    """Merge the two slices, neighbours in heading, whose hull is thinnest in heading; the
+    last slice moves into the freed slot. Returns ``n - 1``."""
+    BXL, BXH = bank[11], bank[12]
+    order = np.argsort(BXL[:n, 2])
+    best, at = np.inf, 0
+    for i in range(n - 1):
+        a, b = order[i], order[i + 1]
+        w = max(BXH[a, 2], BXH[b, 2]) - min(BXL[a, 2], BXL[b, 2])
+        if w < best:
+            best, at = w, i
+    a, b = order[at], order[at + 1]
+    _hull_into(bank[0][a], bank[1][a], bank[0][b], bank[1][b])
+    _hull_into(bank[2][a], bank[3][a], bank[2][b], bank[3][b])
+    _hull_into(BXL[a:a + 1], BXH[a:a + 1], BXL[b:b + 1], BXH[b:b + 1])
+    if b != n - 1:
+        _move(bank, n - 1, b)
+    return n - 1
+
+
+@_njit
+def bank_update(k, ul, uh, alpha, dl, dh, par, eps, x0l, x0h, rl, rh, hl, hh, tp, bank, xl, xh,
+                work, cell_l, cell_h):
+    """Update ``k`` of one mission whose set is a bank of heading slices (module docstring),
+    in place; the arguments as in :func:`observer_update`, with ``bank`` (:func:`make_bank`)
+    for ``ring``.
+
+    ``eps[2]``: the widest heading [rad] a slice may have at ``k - 1`` before it is cut in two
+    (``inf``: one slice, the plain observer); at most half the bank's slots are kept. Returns
+    ``(rejected, empty, cells)``: the pings that every slice rejects, whether every slice came
+    out empty (then the observer restarted from the window alone, as one slice), and the
+    cells: with slices, the slices kept (their boxes into ``cell_l``/``cell_h``); otherwise
+    the ``(x, y)`` paving's cells.
+    """
+    SL, SH, FL, FH, PL, PH, UL, UH, AL, DL, DH, BXL, BXH, live = bank
+    m = par[M]
+    first = max(0, k - m + 1)
+    sliced = eps[2] < np.inf
+    n = 1 if k == 0 else live[0]
+    if k > 0 and sliced:
+        p = (k - 1) % m
+        for b in range(n):
+            lo, hi = SL[b, p, 2], SH[b, p, 2]
+            if n < SL.shape[0] and eps[2] < hi - lo < np.inf:
+                mid = 0.5 * (lo + hi)
+                _move(bank, b, n)
+                SH[b, p, 2] = mid
+                SL[n, p, 2] = mid
+                n += 1
+    inner = eps.copy()
+    inner[2] = np.inf
+    n_in = 0 if sliced else cell_l.shape[0]
+    kept, rejected, empty, cells = 0, 0, False, 0
+    for b in range(n):
+        ring = (SL[b], SH[b], PL, PH, FL[b], FH[b], UL, UH, AL, DL, DH)
+        rejected, empty, cells = observer_update(
+            k, ul, uh, alpha, dl, dh, par, inner, x0l, x0h, rl, rh, hl, hh, tp, ring, BXL[b],
+            BXH[b], work, cell_l[:n_in], cell_h[:n_in], n == 1)
+        if n == 1 or not empty:
+            if kept != b:
+                _move(bank, b, kept)
+            kept += 1
+    if kept == 0:  # every slice empty: restart from the window alone, as one slice
+        ring = (SL[0], SH[0], PL, PH, FL[0], FH[0], UL, UH, AL, DL, DH)
+        rejected = _conclude(False, k, par, hl, hh, tp, ring, BXL[0], BXH[0], work)
+        kept, empty = 1, True
+    elif n > 1:
+        empty = False
+        while kept > SL.shape[0] // 2:
+            kept = _merge_thinnest(bank, kept)
+        rejected = 0
+        for j in range(first, k + 1):
+            every = True
+            for b in range(kept):
+                every = every and _misses(FL[b], FH[b], j % m, BXL[b], BXH[b])
+            if every:
+                rejected += 1
+    live[0] = kept
+    xl[:] = BXL[0]
+    xh[:] = BXH[0]
+    for b in range(1, kept):
+        for c in range(4):
+            xl[c] = min(xl[c], BXL[b, c])
+            xh[c] = max(xh[c], BXH[b, c])
+    if sliced:
+        cells = kept
+        for b in range(min(kept, cell_l.shape[0])):
+            cell_l[b] = BXL[b]
+            cell_h[b] = BXH[b]
+    return rejected, empty, cells
+
+
+@_njit
+def run_missions(UL, UH, alpha, DLO, DHI, par, eps, x0l, x0h, rl, rh, hl, hh, tp, bank, work,
                  XL, XH, rejected, empty, cells, CL, CH):
     """Every update of every mission (``UL``: ``(M, n, 2)``, ``DLO``: ``(M, n)``), results into
     ``XL``/``XH`` ``(M, n, 4)``, ``rejected``, ``empty`` and ``cells`` ``(M, n)``, the kept
-    cells of the paving into ``CL``/``CH`` ``(M, n, C, 4)`` (``C = 0``: not kept)."""
+    cells (or slices) into ``CL``/``CH`` ``(M, n, C, 4)`` (``C = 0``: not kept)."""
     for i in range(DLO.shape[0]):
         for k in range(DLO.shape[1]):
             p = max(k - 1, 0)
-            rej, emp, nc = observer_update(k, UL[i, p], UH[i, p], alpha[k], DLO[i, k],
-                                           DHI[i, k], par, eps, x0l, x0h, rl, rh, hl, hh, tp,
-                                           ring, XL[i, k], XH[i, k], work, CL[i, k], CH[i, k])
+            rej, emp, nc = bank_update(k, UL[i, p], UH[i, p], alpha[k], DLO[i, k], DHI[i, k],
+                                       par, eps, x0l, x0h, rl, rh, hl, hh, tp, bank, XL[i, k],
+                                       XH[i, k], work, CL[i, k], CH[i, k])
             rejected[i, k] = rej
             empty[i, k] = emp
             cells[i, k] = nc
