@@ -3,13 +3,14 @@ observer on the embedded mission, its online update time, and a Monte Carlo chec
 set guarantees.
 
 - Embedded mission, in-process and warm: ``scenarios.pool.solve_pool`` in each mode (the
-  recursive box observer, smoothed inside the window, pavings of the heading and of (x, y)) at
+  recursive box observer, smoothed inside the window, heading slices, a paving of (x, y)) at
   q = 8 (median of ``--repeat`` runs for the fast modes), mean widths, empty steps (restarts),
   the most pings rejected in a window; the smoothed mode at each ``--qs``; the online
   ``PoolObserver.update`` timed step by step (median, p99, max).
 - Monte Carlo: simulated missions (``scenarios.pool_sim.simulate_pool``, outliers with
   p = 0.05), in batches of ``--chunk``, for the recursive box observer (``--missions``), the
-  smoothed recursive and the pure window observers (``--missions-smoothed``). Per step: the
+  smoothed recursive and the pure window observers (``--missions-smoothed``), and the
+  recursive observer with heading slices (``--missions-sliced``). Per step: the
   empirical frequency with which the set contains the truth, with its 95 % Wilson score
   interval, next to the per-window binomial bound ``P(at most q outliers among the window's
   pings)`` (the pure window observer's guarantee) and to the empirical frequency of the event
@@ -69,6 +70,9 @@ def main() -> int:
     ap.add_argument("--missions-smoothed", type=int, default=300,
                     help="Monte Carlo missions of the smoothed recursive and the pure window "
                     "observers (about 1.4 s each)")
+    ap.add_argument("--missions-sliced", type=int, default=100,
+                    help="Monte Carlo missions of the recursive observer with heading slices "
+                    "of 0.01 rad, at most 32 (about 1.2 s each)")
     ap.add_argument("--chunk", type=int, default=1000)
     args = ap.parse_args()
 
@@ -88,13 +92,19 @@ def main() -> int:
                            "q6": "empty at the 4 steps whose window holds 7 outliers"}}
     data = load_pool()
     modes = {"box": {"sweeps": 0}, "smoothed": {"sweeps": 1},
-             "heading_paving_0.1": {"sweeps": 0, "paving_heading": 0.1},
-             "heading_paving_0.05": {"sweeps": 0, "paving_heading": 0.05},
+             "heading_slices_0.05_x8": {"sweeps": 0, "paving_heading": 0.05,
+                                        "heading_slices": 8},
+             "heading_slices_0.01_x32": {"sweeps": 0, "paving_heading": 0.01,
+                                         "heading_slices": 32},
+             "heading_slices_0.01_x128": {"sweeps": 0, "paving_heading": 0.01,
+                                          "heading_slices": 128},
+             "smoothed_heading_slices_0.05_x8": {"sweeps": 1, "paving_heading": 0.05,
+                                                 "heading_slices": 8},
              "xy_paving_0.25": {"sweeps": 0, "paving": 0.25}}
     emb: dict[str, Any] = {}
     for name, kw in modes.items():
         solve_pool(data, q=args.q, m=args.m, **kw)  # compiles or loads the kernel
-        reps = args.repeat if name in ("box", "smoothed") else 1
+        reps = args.repeat if name in ("box", "smoothed", "heading_slices_0.05_x8") else 1
         runs = [solve_pool(data, q=args.q, m=args.m, **kw) for _ in range(reps)]
         res = runs[-1]
         w = res.widths()
@@ -115,7 +125,7 @@ def main() -> int:
         log(f"embedded smoothed q={q}: {res.time_s:.2f} s, widths {res.widths().mean(0)[:2]}")
     rec["embedded_smoothed_by_q"] = by_q
     online = {}
-    for name in ("box", "smoothed"):
+    for name in ("box", "smoothed", "heading_slices_0.01_x32"):
         obs = PoolObserver(data, q=args.q, m=args.m, **modes[name])
         steps = []
         for k in range(data.n):
@@ -138,6 +148,9 @@ def main() -> int:
         "window_only": monte_carlo(solve_pool, simulate_pool, args.missions_smoothed,
                                    args.chunk, args.q, args.m, {"carry": False}, data.n,
                                    seed0=10**6),
+        "recursive_heading_slices": monte_carlo(
+            solve_pool, simulate_pool, args.missions_sliced, args.chunk, args.q, args.m,
+            modes["heading_slices_0.01_x32"], data.n, seed0=2 * 10**6),
     }
     rec["loadavg_end"] = os.getloadavg()
     emit(rec, args.out)

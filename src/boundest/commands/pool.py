@@ -124,7 +124,7 @@ def _run(args: argparse.Namespace, figures: FigureWorker) -> int:
         what = "heading slices" if res.eps[1] is not None else "cells"
         print(f"paving ({_sides(res.eps)}): {res.cells.mean():.1f} {what} kept per step on "
               "average")
-    print("  " + _mode_line(args.sweeps, paved))
+    print("  " + _mode_line(args.sweeps, args.paving, args.paving_heading))
     rows = table_rows(data, res)
     table = format_table(rows, args.q)
     print("table (P: one window, see above):")
@@ -228,13 +228,16 @@ def to_json(data, res, args, p_full: float, rows: list[dict], per_update=None) -
             "time_s": res.time_s, "table": rows, "steps": steps}
 
 
-def _mode_line(sweeps: int, paved: bool) -> str:
+def _mode_line(sweeps: int, paving: float | None, heading: float | None) -> str:
     """Which contraction this run used, and what the other choices cost (the measured table of
     the README: embedded mission, q = 8, in-process warm times, 2026-12-04)."""
-    table = ("in-process, quiet machine: --sweeps 0: 0.02 s, 0.96 x 0.87 m; default --sweeps 1: "
-             "0.9 s, 0.74 x 0.66 m; --sweeps 0 --paving-heading 0.05: 4.4 s, 0.61 x 0.48 m")
-    if paved:
-        return f"mode: paving, the tightest and slowest (on the embedded mission {table})"
+    table = ("in-process: --sweeps 0: 0.02 s, 0.96 x 0.87 m; default --sweeps 1: 0.8 s, 0.74 x "
+             "0.66 m; --sweeps 0 --paving-heading 0.01: 1.2 s, 0.57 x 0.42 m")
+    if heading is not None:
+        return f"mode: heading slices, the tightest (on the embedded mission {table})"
+    if paving is not None:
+        return ("mode: (x, y) paving, slower and wider than heading slices (on the embedded "
+                f"mission {table}; --sweeps 0 --paving 0.25: 7.3 s, 0.68 x 0.55 m)")
     if sweeps == 0:
         return f"mode: the recursive box observer, no smoothing, the fastest ({table})"
     return f"mode: smoothing inside the window ({table})"
