@@ -45,6 +45,9 @@ def test_scheduler_without_distributed_is_one_sentence(monkeypatch, tmp_path, ca
     (["--monte-carlo", "10", "--workers", "2", "--scheduler", "x"], "not both"),
     (["--monte-carlo", "0"], "at least 1 mission"),
     (["--monte-carlo", "10", "--workers", "0"], "--workers must be at least 1"),
+    (["--monte-carlo", "10", "--online"], "does not take --online"),
+    (["--monte-carlo", "10", "--paving-heading", "0"], "paving_heading precision"),
+    (["--monte-carlo", "10", "--paving-heading", "0.1", "--window-only"], "recursive observer"),
 ])
 def test_bad_monte_carlo_options(argv, says, tmp_path, capsys):
     assert main(["run", "pool", *argv, "--out", str(tmp_path)]) == 2
@@ -56,3 +59,14 @@ def test_wilson_interval_known_values():
     # Wilson (1927): 0/10 -> [0, 0.2775], 5/10 -> [0.2366, 0.7634], 10/10 -> [0.7225, 1]
     assert np.allclose(lo, [0.0, 0.23659, 0.72246], atol=1e-4)
     assert np.allclose(hi, [0.27753, 0.76341, 1.0], atol=1e-4)
+
+
+def test_monte_carlo_of_heading_slices(tmp_path, capsys):
+    js = tmp_path / "mc.json"
+    main(["run", "pool", "--monte-carlo", "2", "--mc-chunk", "2", "--paving-heading", "0.05",
+          "--heading-slices", "4", "--out", str(tmp_path), "--json", str(js)])
+    data = json.loads(js.read_text())
+    assert data["observer"] == {"sweeps": 0, "carry": True, "paving": None,
+                                "paving_heading": 0.05, "heading_slices": 4}
+    assert data["guarantee_violations"] == 0
+    assert "paving_heading = 0.05, heading_slices = 4" in capsys.readouterr().out

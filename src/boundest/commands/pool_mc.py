@@ -72,6 +72,9 @@ def run_monte_carlo(args: argparse.Namespace) -> int:
     if args.data:
         raise ValueError("--monte-carlo simulates missions of the embedded setup; it does not "
                          "read --data")
+    if args.online:
+        raise ValueError("--monte-carlo runs each chunk of missions offline, in one call; it "
+                         "does not take --online")
     with executor_of(args) as ex:
         where = (f"on the cluster at {args.scheduler}" if args.scheduler else
                  f"on {args.workers} local worker processes" if args.workers else "in-process")
@@ -81,10 +84,15 @@ def run_monte_carlo(args: argparse.Namespace) -> int:
         mc = pool_monte_carlo(args.monte_carlo, args.q, args.m, seed=args.mc_seed,
                               chunk=args.mc_chunk, executor=ex, progress=None,
                               sweeps=0 if args.sweeps is None else args.sweeps,
-                              carry=not args.window_only)
+                              carry=not args.window_only, paving=args.paving,
+                              paving_heading=args.paving_heading,
+                              **({} if args.heading_slices is None else
+                                 {"heading_slices": args.heading_slices}))
     freq = mc.frequency()
     below = int(np.count_nonzero(freq < mc.window_probability))
     hi = mc.ci()[1]
+    print("observer: " + ", ".join(f"{k} = {v}" for k, v in mc.observer.items()
+                                   if v is not None))
     print(f"time: {mc.time_s:.1f} s ({mc.solve_s:.1f} s in the observer, summed over tasks; "
           f"{mc.empty_steps} empty steps in all)")
     print(f"containment: min {freq.min():.4f} at k = {int(freq.argmin())}; frequency below the "

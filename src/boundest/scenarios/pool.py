@@ -26,7 +26,7 @@ from . import pool_observer as po
 from .pool_data import PoolData, binomial_bound
 
 __all__ = ["DEFAULT_PASSES", "DEFAULT_SLICES", "DEFAULT_SWEEPS", "PoolObserver", "PoolResult",
-           "restart_box", "solve_pool", "window_probabilities"]
+           "check_options", "restart_box", "solve_pool", "window_probabilities"]
 
 #: Smoothing rounds per ping by default (see the benchmark: the widths it buys, its time).
 DEFAULT_SWEEPS = 1
@@ -73,6 +73,17 @@ def _eps(paving: float | None, heading: float | None, slices: int, carry: bool) 
                          "(--window-only, carry=False)")
     xy = np.inf if paving is None else float(paving)
     return np.array([xy, xy, np.inf if heading is None else float(heading)])
+
+
+def check_options(q: int = 8, m: int = 80, sweeps: int = DEFAULT_SWEEPS,
+                  passes: int = DEFAULT_PASSES, carry: bool = True, paving: float | None = None,
+                  paving_heading: float | None = None, heading_slices: int | None = None
+                  ) -> None:
+    """Raise the ``ValueError`` that :func:`solve_pool` would raise for these options
+    (``heading_slices`` None: the default), without running anything."""
+    _check(q, m, sweeps, passes, carry)
+    _eps(paving, paving_heading, DEFAULT_SLICES if heading_slices is None else heading_slices,
+         carry)
 
 
 def _slices(eps: np.ndarray, slices: int) -> int:

@@ -27,14 +27,14 @@ from __future__ import annotations
 import math
 import time
 from concurrent.futures import Executor
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import partial
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ..parallel import executor_workers, map_chunked
-from .pool import solve_pool
+from .pool import DEFAULT_SLICES, check_options, solve_pool
 from .pool_sim import simulate_pool
 
 __all__ = ["MonteCarloResult", "pool_monte_carlo", "wilson"]
@@ -74,12 +74,12 @@ class _Counts:
 
 
 def _chunk_counts(seed_size: tuple[int, int], q: int, m: int, p_outlier: float,
-                  n_samples: int, sweeps: int = 0, carry: bool = True) -> _Counts:
+                  n_samples: int, observer: dict) -> _Counts:
     """Simulate the missions of one chunk, run the observer on them, count (on a worker)."""
     seed, size = seed_size
     sim, truth = simulate_pool(seed=seed, n_missions=size, p_outlier=p_outlier,
                                n_samples=n_samples)
-    res = solve_pool(sim, q=q, m=m, sweeps=sweeps, carry=carry)
+    res = solve_pool(sim, q=q, m=m, keep_cells=0, **observer)
     hit = ((res.boxes.lo <= truth.states) & (truth.states <= res.boxes.hi)).all(-1)
     ok = _windows_ok(truth.outlier, m, q)
     return _Counts(hit.sum(0), ok.sum(0), (hit & ok).sum(0), int(res.empty.sum()),
@@ -113,6 +113,8 @@ class MonteCarloResult:
         Wall-clock seconds of the run; seconds the observer ran (summed over the tasks).
     workers : int
         Tasks the executor ran at once.
+    observer : dict
+        The observer's options (:func:`~boundest.scenarios.pool.solve_pool`).
     """
 
     missions: int
@@ -130,6 +132,7 @@ class MonteCarloResult:
     time_s: float
     solve_s: float
     workers: int
+    observer: dict = field(default_factory=dict)
 
     def frequency(self) -> NDArray[np.float64]:
         """Empirical ``P(x_k in X_k)`` per step."""
@@ -146,7 +149,8 @@ class MonteCarloResult:
         below = freq < self.window_probability
         return {"scenario": "pool-monte-carlo", "missions": self.missions, "q": self.q,
                 "m": self.m, "p_outlier": self.p_outlier, "seed": self.seed,
-                "chunk": self.chunk, "workers": self.workers, "time_s": self.time_s,
+                "chunk": self.chunk, "workers": self.workers, "observer": self.observer,
+                "time_s": self.time_s,
                 "solve_s": self.solve_s, "empty_steps_total": self.empty_steps,
                 "min_containment": float(freq.min()), "step_of_min": int(freq.argmin()),
                 "steps_below_bound": int(below.sum()),
@@ -160,7 +164,9 @@ class MonteCarloResult:
 
 def pool_monte_carlo(missions: int, q: int = 8, m: int = 80, *, p_outlier: float = 0.05,
                      seed: int = 0, chunk: int = 250, n_samples: int = 406,
-                     sweeps: int = 0, carry: bool = True,
+                     sweeps: int = 0, carry: bool = True, paving: float | None = None,
+                     paving_heading: float | None = None,
+                     heading_slices: int = DEFAULT_SLICES,
                      executor: Executor | None = None, progress: bool | None = None
                      ) -> MonteCarloResult:
     """Simulate ``missions`` pool missions, run the robust observer on each, count per step
@@ -181,10 +187,11 @@ def pool_monte_carlo(missions: int, q: int = 8, m: int = 80, *, p_outlier: float
         is mostly fixed, so large chunks are much cheaper per mission).
     n_samples : int
         Pings per mission (default: the 406 of the embedded mission's setup).
-    sweeps, carry : int, bool
+    sweeps, carry, paving, paving_heading, heading_slices
         The observer (:func:`~boundest.scenarios.pool.solve_pool`): smoothing rounds (default
-        0, the recursive box observer: 0.02 s a mission, against about 1 s smoothed), and
-        recursive (True) or pure window (False).
+        0, the recursive box observer: 0.02 s a mission, against about 1 s smoothed),
+        recursive (True) or pure window (False), an ``(x, y)`` paving, heading slices (about
+        1 s a mission at 0.01 rad).
     executor : concurrent.futures.Executor, optional
         Where the chunks run (``boundest.parallel``); None: in this process.
     progress : bool or None
@@ -194,10 +201,14 @@ def pool_monte_carlo(missions: int, q: int = 8, m: int = 80, *, p_outlier: float
         raise ValueError(f"need missions >= 1 and chunk >= 1, got {missions} and {chunk}")
     if q < 0 or m < 1:
         raise ValueError(f"need q >= 0 and m >= 1, got q = {q}, m = {m}")
+    observer = {"sweeps": sweeps, "carry": carry, "paving": paving,
+                "paving_heading": paving_heading,
+                "heading_slices": None if paving_heading is None else heading_slices}
+    check_options(q, m, **observer)  # one clear error here, not one per task
     t0 = time.perf_counter()
     tasks = [(seed + s, min(chunk, missions - s)) for s in range(0, missions, chunk)]
     parts = map_chunked(partial(_chunk_counts, q=q, m=m, p_outlier=p_outlier,
-                                n_samples=n_samples, sweeps=sweeps, carry=carry), tasks,
+                                n_samples=n_samples, observer=_given(observer)), tasks,
                         executor,
                         chunk=1, progress=progress, desc=f"missions/{chunk}")
     first = parts[0]
@@ -211,4 +222,8 @@ def pool_monte_carlo(missions: int, q: int = 8, m: int = 80, *, p_outlier: float
         sum((p.inside_when_ok for p in parts), np.zeros_like(first.inside_when_ok)),
         first.window_probability, sum(p.empty_steps for p in parts),
         time.perf_counter() - t0, math.fsum(p.solve_s for p in parts),
-        executor_workers(executor))
+        executor_workers(executor), observer)
+
+
+def _given(observer: dict) -> dict:
+    return {k: v for k, v in observer.items() if v is not None}
