@@ -219,7 +219,7 @@ def to_json(data, res, args, p_full: float, rows: list[dict], per_update=None) -
             "sweeps": args.sweeps, "paving": args.paving,
             "paving_heading": args.paving_heading,
             "heading_slices": (None if args.paving_heading is None else
-                               kw_slices(args)),
+                               _heading_slices(args)),
             "online": online,
             "window_probability": p_full,
             "guarantee": GUARANTEE[not args.window_only].format(m=args.m, q=args.q),
@@ -243,7 +243,7 @@ def _mode_line(sweeps: int, paving: float | None, heading: float | None) -> str:
     return f"mode: smoothing inside the window ({table})"
 
 
-def kw_slices(args: argparse.Namespace) -> int:
+def _heading_slices(args: argparse.Namespace) -> int:
     """The most heading slices this run keeps (``--heading-slices``, else the default)."""
     from ..scenarios.pool import DEFAULT_SLICES
 
