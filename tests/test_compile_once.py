@@ -41,7 +41,8 @@ _SCRIPT = textwrap.dedent("""
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("argv", [["run", "satellite"], ["run", "drifting-clock"]])
+@pytest.mark.parametrize("argv", [["run", "satellite"], ["run", "drifting-clock"],
+                                  ["run", "pool"]])  # pool: about 40 s
 def test_each_kernel_is_compiled_once(argv, tmp_path):
     env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache"),
            "BOUNDEST_KERNEL_ARCHIVE": "0"}

@@ -21,9 +21,10 @@ from .commands import SCENARIOS, save_figure, subplots, write_json
 #: Measured empty-cache first run of each command without the shipped kernel archive
 #: (``BOUNDEST_KERNEL_ARCHIVE=0``, ``benchmarks/bench_startup.py``, a quiet 2-core machine,
 #: 2026-12-04; under load from other jobs it took up to 3x as long), printed when a run starts
-#: compiling; with the archive nothing compiles.
+#: compiling; with the archive nothing compiles. pool: 38 s times the 1.18x that the heading
+#: slices' kernels cost, measured side by side (44.9 -> 52.8 s, median of two, same machine).
 COMPILE_ESTIMATE_S = {"satellite": 11, "jaulin2001": 8, "range-only": 14,
-                      "drifting-clock": 10, "auv": 14, "pool": 38, "solve": 9, "demo": 4}
+                      "drifting-clock": 10, "auv": 14, "pool": 45, "solve": 9, "demo": 4}
 
 
 def _demo(args: argparse.Namespace) -> int:

@@ -603,7 +603,9 @@ def bank_update(k, ul, uh, alpha, dl, dh, par, eps, x0l, x0h, rl, rh, hl, hh, tp
     m = par[M]
     first = max(0, k - m + 1)
     sliced = eps[2] < np.inf
-    n = 1 if k == 0 else live[0]
+    # np.int64 counters and a bool variable, not literals: the callees (_move, _merge_thinnest,
+    # _conclude) would be compiled once more for Literal[int] / Literal[bool]
+    n = np.int64(1) if k == 0 else live[0]
     if k > 0 and sliced:
         p = (k - 1) % m
         for b in range(n):
@@ -617,7 +619,7 @@ def bank_update(k, ul, uh, alpha, dl, dh, par, eps, x0l, x0h, rl, rh, hl, hh, tp
     inner = eps.copy()
     inner[2] = np.inf
     n_in = 0 if sliced else cell_l.shape[0]
-    kept, rejected, empty, cells = 0, 0, False, 0
+    kept, rejected, empty, cells = np.int64(0), np.int64(0), False, np.int64(0)
     for b in range(n):
         ring = (SL[b], SH[b], PL, PH, FL[b], FH[b], UL, UH, AL, DL, DH)
         rejected, empty, cells = observer_update(
@@ -629,13 +631,14 @@ def bank_update(k, ul, uh, alpha, dl, dh, par, eps, x0l, x0h, rl, rh, hl, hh, tp
             kept += 1
     if kept == 0:  # every slice empty: restart from the window alone, as one slice
         ring = (SL[0], SH[0], PL, PH, FL[0], FH[0], UL, UH, AL, DL, DH)
-        rejected = _conclude(False, k, par, hl, hh, tp, ring, BXL[0], BXH[0], work)
-        kept, empty = 1, True
+        ok = kept > 0  # False, as a variable (see above)
+        rejected = _conclude(ok, k, par, hl, hh, tp, ring, BXL[0], BXH[0], work)
+        kept, empty = np.int64(1), True
     elif n > 1:
         empty = False
         while kept > SL.shape[0] // 2:
             kept = _merge_thinnest(bank, kept)
-        rejected = 0
+        rejected = np.int64(0)
         for j in range(first, k + 1):
             every = True
             for b in range(kept):
