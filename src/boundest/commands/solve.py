@@ -132,6 +132,56 @@ def pave(model: Any, domains: dict[str, Any], eps: float, max_boxes: int) -> Any
     return sivia(Interval._new(lo, hi), ctc_out=ctc, eps=eps, max_boxes=max_boxes)
 
 
+_WHY = {"eps": "narrower than eps without a proof (a multiple or singular root, or no root "
+               "that could be refuted)",
+        "discontinuous": "where some function is undefined or discontinuous",
+        "max_boxes": "left when --max-boxes ran out"}
+
+
+def is_square(model: Any) -> bool:
+    """Whether the model is a square system: as many equations as variables, and no other
+    constraint (then ``--paving`` runs interval Newton and proves solutions)."""
+    eqs = sum(c.rel == "==" for c in model.constraints)
+    return eqs == len(model.constraints) and eqs == len(model.variable_names()) and eqs > 0
+
+
+def pave_square(model: Any, domains: dict[str, Any], eps: float, max_boxes: int) -> Any:
+    """Branch and prune with interval Newton on the propagated domains
+    (``boundest.paving.roots.solve_square``): proved and undecided boxes."""
+    import numpy as np
+
+    from ..expr import Model
+    from ..interval import Interval
+    from ..paving.roots import solve_square
+
+    names = list(domains)
+    lo = np.array([float(domains[n].lo) for n in names])
+    hi = np.array([float(domains[n].hi) for n in names])
+    unb = [n for n, a, b in zip(names, lo, hi, strict=True) if not np.isfinite(b - a)]
+    if unb:
+        raise ValueError(f"solving a square system needs bounded domains; after propagation "
+                         f"{', '.join(unb)} {'is' if len(unb) == 1 else 'are'} unbounded")
+    square = Model(domains=dict(domains), constraints=list(model.constraints))
+    return solve_square(square, Interval(lo, hi), eps=eps, max_boxes=max_boxes)
+
+
+def _figure_roots(roots: Any, args: argparse.Namespace) -> None:
+    """Proved boxes in green, undecided ones in yellow, projected on the first two variables."""
+    from ..paving import Subpaving
+    from ..plot.paving import plot_paving
+
+    fig, ax = subplots(figsize=(6, 5.5))
+    drawn = Subpaving(roots.boxes, roots.proved)  # 'inside' stands for 'proved' in the drawing
+    plot_paving(drawn, ax=ax, dims=(0, 1), inside="tab:green", linewidth=0.8,
+                labels=("proved: exactly one solution", "undecided", None))
+    ax.set_xlabel(roots.variables[0])
+    ax.set_ylabel(roots.variables[1])
+    ax.legend(loc="best", fontsize=8)
+    ax.set_title(f"{Path(args.file).name}: interval Newton, {int(roots.proved.sum())} proved, "
+                 f"{int((~roots.proved).sum())} undecided", fontsize=9)
+    save_figure(fig, args.out, f"{Path(args.file).stem}_paving")
+
+
 def _phases(res: Any) -> str:
     """The cost of the phases after hull consistency, for the summary line."""
     parts = []
@@ -180,7 +230,31 @@ def run(args: argparse.Namespace) -> int:
                             "evaluations": res.evaluations, "time_s": res.time_s,
                             "domains": res.domains}
     paving = None
-    if eps is not None and res.consistent:
+    if eps is not None and res.consistent and is_square(model):
+        roots = pave_square(model, res.domains, eps, args.max_boxes)
+        n_proved, n_und = int(roots.proved.sum()), int((~roots.proved).sum())
+        why = ", ".join(f"{v} {_WHY[k]}" for k, v in roots.stats["undecided_why"].items() if v)
+        print(f"square system, interval Newton (eps = {eps:g}): {n_proved} solutions proved "
+              f"(each box holds exactly one), {n_und} undecided boxes"
+              + (f" ({why})" if why else "")
+              + f"; {roots.stats['processed']} boxes contracted in "
+                f"{roots.stats['time_s']:.3f} s; stopped by {roots.stats['stopped']}")
+        for i, b in enumerate(roots.solutions[:10]):
+            print(f"  solution {i + 1}: " + ", ".join(
+                f"{v} in [{float(a)!r}, {float(c)!r}]"
+                for v, a, c in zip(roots.variables, b.lo, b.hi, strict=True)))
+        if n_proved > 10:
+            print(f"  ... and {n_proved - 10} more (--json writes them all)")
+        data["paving"] = {"eps": eps, "method": "newton", "variables": roots.variables,
+                          "boxes": roots.boxes, "proved": roots.proved.tolist(),
+                          "stopped": roots.stats["stopped"],
+                          "undecided_why": roots.stats["undecided_why"]}
+        if len(roots) and len(roots.variables) >= 2:
+            _figure_roots(roots, args)
+        if not len(roots):
+            write_json(data, args.json)
+            return 1
+    elif eps is not None and res.consistent:
         paving = pave(model, res.domains, eps, args.max_boxes)
         st = paving.stats
         empty = len(paving) == 0
