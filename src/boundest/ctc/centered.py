@@ -47,7 +47,7 @@ _njit = nb.njit(cache=True, error_model="numpy")
 def _as_tape(system: FunctionTape | Model) -> FunctionTape:
     if isinstance(system, FunctionTape):
         return system
-    if isinstance(system, Model) or isinstance(system, (list, tuple)):
+    if isinstance(system, (Model, list, tuple)):
         return constraint_functions(system)[0]
     raise TypeError(f"expected a Model, a list of constraints or a FunctionTape, got "
                     f"{type(system).__name__}")
@@ -92,20 +92,21 @@ def _rhs(tl, th, fl, fh):
 
 @_njit
 def _centered_kernel(el, eh, row_ptr, cols, fcl, fch, vl, vh, tl, th, xl, xh, c, precondition):
-    """Contract each box ``(xl[b], xh[b])`` in place; an empty box gets NaN bounds."""
+    """Contract each box ``(xl[b], xh[b])`` in place; an empty box gets NaN bounds. The
+    targets ``tl, th`` are per box, shape (n_boxes, m)."""
     n = xl.shape[1]
     for bx in range(xl.shape[0]):
         if not (np.all(xl[bx] <= xh[bx])):
             continue
         empty = False
-        for k in range(tl.size):  # the natural form already refutes the box
-            if vl[bx, k] > th[k] or vh[bx, k] < tl[k]:
+        for k in range(tl.shape[1]):  # the natural form already refutes the box
+            if vl[bx, k] > th[bx, k] or vh[bx, k] < tl[bx, k]:
                 empty = True
         if not empty:
             if np.any(np.isnan(fcl[bx])):
                 continue  # the centre is outside some primitive's domain: no linearisation
             jl, jh = _dense(el[bx], eh[bx], row_ptr, cols, n)
-            zl, zh = _rhs(tl, th, fcl[bx], fch[bx])
+            zl, zh = _rhs(tl[bx], th[bx], fcl[bx], fch[bx])
             dl = np.empty(n)
             dh = np.empty(n)
             for j in range(n):
@@ -151,9 +152,10 @@ class CtcCentered(_Linearised):
     system : Model, list of Constraint or FunctionTape
         The constraints (see :func:`boundest.expr.function_tape.constraint_functions`).
     precondition : bool
-        Also contract with the Gauss-Jordan preconditioned rows (asymptotically minimal; costs
-        ``O(m^2 n)`` per box). Without it each constraint's linearisation is used on its own,
-        as Codac 2's ``CtcInverse`` does.
+        After each constraint's linearisation on its own (what Codac 2's ``CtcInverse`` does,
+        all of it when False), also contract with the rows of ``P J`` with ``P`` from
+        Gauss-Jordan elimination on ``mid(J)`` (asymptotically minimal for narrow boxes and
+        ``m <= n``; ``O(m^2 (m + n))`` per box).
 
     Examples
     --------
@@ -168,12 +170,22 @@ class CtcCentered(_Linearised):
         super().__init__(system)
         self.precondition = bool(precondition)
 
-    def contract(self, x: Interval) -> Interval:
+    def contract(self, x: Interval, targets: Interval | None = None) -> Interval:
+        """Contract boxes ``(..., n)``; ``targets`` (broadcast to ``(..., m)``) replaces the
+        tape's target sets, one per box (the same constraints with other data)."""
         box, c, values, entries, _, fc = self._linearise(x)
         lo, hi = box.lo.copy(), box.hi.copy()
         t = self.tape
+        if targets is None:
+            tl = np.broadcast_to(t.target_lo, (len(lo), t.n_outputs))
+            th = np.broadcast_to(t.target_hi, (len(lo), t.n_outputs))
+        else:
+            shape = (*x.shape[:-1], t.n_outputs)
+            tl = np.broadcast_to(targets.lo, shape).reshape(len(lo), -1)
+            th = np.broadcast_to(targets.hi, shape).reshape(len(lo), -1)
         _centered_kernel(entries.lo, entries.hi, t.row_ptr, t.cols, fc.lo, fc.hi, values.lo,
-                         values.hi, t.target_lo, t.target_hi, lo, hi, c, self.precondition)
+                         values.hi, np.ascontiguousarray(tl), np.ascontiguousarray(th), lo, hi,
+                         c, self.precondition)
         return _empty_rows(Interval._new(lo.reshape(x.shape), hi.reshape(x.shape)))
 
 

@@ -113,7 +113,8 @@ def _slopes_other(code, zl, zh, xl, xh, yl, yh, p, buf):
     if code == EXP:
         return zl, zh, 0.0, 0.0
     if code == LOG:  # 1/x over the part x > 0 of the domain
-        return _div(1.0, 1.0, max(xl, 0.0), xh) + (0.0, 0.0)
+        dl, dh = _div(1.0, 1.0, max(xl, 0.0), xh)
+        return dl, dh, 0.0, 0.0
     if code == SIN:
         _f_cos(xl, xh, o0, o1)
         return buf[0], buf[1], 0.0, 0.0
@@ -123,20 +124,25 @@ def _slopes_other(code, zl, zh, xl, xh, yl, yh, p, buf):
     if code == TAN:  # 1 + tan^2, unless the box meets a pole (then tan's image is unbounded)
         if zl == -INF or zh == INF:
             return -INF, INF, 0.0, 0.0
-        return _one_plus_sqr(zl, zh) + (0.0, 0.0)
-    if code == ASIN or code == ACOS:  # +-1/sqrt(1 - x^2) over x in [-1, 1]
+        dl, dh = _one_plus_sqr(zl, zh)
+        return dl, dh, 0.0, 0.0
+    if code in (ASIN, ACOS):  # +-1/sqrt(1 - x^2) over x in [-1, 1]
         dl, dh = _one_minus_sqr(max(xl, -1.0), min(xh, 1.0))
         dl, dh = _div(1.0, 1.0, _sqrt_lo(dl, dh), _sqrt_hi(dl, dh))
         return (dl, dh, 0.0, 0.0) if code == ASIN else (-dh, -dl, 0.0, 0.0)
     if code == ATAN:
         dl, dh = _one_plus_sqr(xl, xh)
-        return _div(1.0, 1.0, dl, dh) + (0.0, 0.0)
+        dl, dh = _div(1.0, 1.0, dl, dh)
+        return dl, dh, 0.0, 0.0
     if code == SINH:
-        return _f_cosh(xl, xh, math.cosh(xl), math.cosh(xh)) + (0.0, 0.0)
+        dl, dh = _f_cosh(xl, xh, math.cosh(xl), math.cosh(xh))
+        return dl, dh, 0.0, 0.0
     if code == COSH:
-        return _f_sinh(xl, xh, math.sinh(xl), math.sinh(xh)) + (0.0, 0.0)
+        dl, dh = _f_sinh(xl, xh, math.sinh(xl), math.sinh(xh))
+        return dl, dh, 0.0, 0.0
     if code == TANH:
-        return _one_minus_sqr(zl, zh) + (0.0, 0.0)
+        dl, dh = _one_minus_sqr(zl, zh)
+        return dl, dh, 0.0, 0.0
     if code == POWN:
         n = np.int64(p)
         if n == 0:
@@ -146,7 +152,8 @@ def _slopes_other(code, zl, zh, xl, xh, yl, yh, p, buf):
         if n < 0 and xl < 0.0 < xh:  # the pole at 0 inside the box
             return -INF, INF, 0.0, 0.0
         _f_pown(xl, xh, n - 1, o0, o1)
-        return _mul(p, p, buf[0], buf[1]) + (0.0, 0.0)
+        dl, dh = _mul(p, p, buf[0], buf[1])
+        return dl, dh, 0.0, 0.0
     if code == POW:  # x**y: y x**(y-1) and log(x) x**y, over x > 0 only
         if xl <= 0.0:
             return -INF, INF, -INF, INF
@@ -220,7 +227,8 @@ def slopes(code, zl, zh, xl, xh, yl, yh, p, buf):
     elif code == SQR:
         r = (2.0 * xl, 2.0 * xh, 0.0, 0.0)
     elif code == SQRT:  # 1 / (2 sqrt(x))
-        r = _div(0.5, 0.5, zl, zh) + (0.0, 0.0)
+        dl, dh = _div(0.5, 0.5, zl, zh)
+        r = (dl, dh, 0.0, 0.0)
     elif code in (ABS, SIGN, FLOOR, CEIL, MIN, MAX):
         r = _slopes_piecewise(code, xl, xh, yl, yh)
     else:
@@ -244,7 +252,7 @@ def defined(code, zl, zh, xl, xh, yl, yh, p):
         return xl >= 0.0
     if code == LOG:
         return xl > 0.0
-    if code == ASIN or code == ACOS:
+    if code in (ASIN, ACOS):
         return xl >= -1.0 and xh <= 1.0
     if code == DIV:
         return not yl <= 0.0 <= yh
@@ -255,7 +263,7 @@ def defined(code, zl, zh, xl, xh, yl, yh, p):
     if code == ATAN2:
         return not ((yl <= 0.0 <= yh and xl <= 0.0 <= xh) or (xl < 0.0 and yl < 0.0 <= yh))
     if code == TAN:
-        return -INF < zl and zh < INF
+        return zl > -INF and zh < INF
     if code == SIGN:
         return xl > 0.0 or xh < 0.0 or xl == xh
     if code == FLOOR:
