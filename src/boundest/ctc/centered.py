@@ -114,7 +114,11 @@ def _centered_kernel(el, eh, row_ptr, cols, fcl, fch, vl, vh, tl, th, xl, xh, c,
                 dh[j] = sub_up(xh[bx, j], c[bx, j])
             empty = not contract_rows(jl, jh, zl, zh, dl, dh)
             if not empty and precondition:
-                P, _ = preconditioner(_midpoints(jl, jh))
+                A = _midpoints(jl, jh)
+                for j in range(n):
+                    w = dh[j] - dl[j]
+                    A[:, j] *= w if math.isfinite(w) else 1e300
+                P, _ = preconditioner(A)
                 ml, mh = point_times(P, jl, jh)
                 rl, rh = point_times(P, zl.reshape(-1, 1), zh.reshape(-1, 1))
                 empty = not contract_rows(ml, mh, rl[:, 0], rh[:, 0], dl, dh)
