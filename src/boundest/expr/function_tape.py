@@ -112,7 +112,8 @@ def function_tape(outputs: Sequence[Expr | float], names: Sequence[str | Var] | 
         var_names = [v.name if isinstance(v, Var) else str(v) for v in names]
         if len(set(var_names)) != len(var_names):
             raise ValueError(f"a variable is listed twice in {var_names}")
-        missing = [v.name for v in variables(exprs) if v.name not in set(var_names)]
+        known = set(var_names)
+        missing = [v.name for v in variables(exprs) if v.name not in known]
         if missing:
             raise ValueError(f"the outputs use variables not among the given names: {missing}")
     if targets is None:
