@@ -37,6 +37,7 @@ from ..interval.rounding import add_dn, add_up, mul_up, sub_dn, sub_up
 from .base import Contractor, _empty_rows
 from .derivatives import evaluate, jacobian_sparse, midpoint
 from .linear_forms import _term, contract_rows, point_times, preconditioner
+from .windows import WINDOW_STATS, batch_kernel
 
 __all__ = ["CtcCentered", "CtcNewton"]
 
@@ -155,11 +156,15 @@ class CtcCentered(_Linearised):
     ----------
     system : Model, list of Constraint or FunctionTape
         The constraints (see :func:`boundest.expr.function_tape.constraint_functions`).
-    precondition : bool
+    precondition : bool or {"gauss-jordan", "lp"}
         After each constraint's linearisation on its own (what Codac 2's ``CtcInverse`` does,
-        all of it when False), also contract with the rows of ``P J`` with ``P`` from
-        Gauss-Jordan elimination on ``mid(J)`` (asymptotically minimal for narrow boxes and
-        ``m <= n``; ``O(m^2 (m + n))`` per box).
+        all of it when False), also contract with the rows of ``P J``: with True or
+        ``"gauss-jordan"``, ``P`` from Gauss-Jordan elimination on ``mid(J)`` with columns
+        scaled by the domains' widths (asymptotically minimal for narrow boxes, Jaulin 2023;
+        ``O(m^2 (m + n))`` per box); with ``"lp"``, for each variable and each of its bounds
+        the aggregation of the rows that a linear programme over the linearisation finds best
+        (:mod:`boundest.ctc.windows`: the hull of the linearised set up to the Jacobian's
+        width, two small dense simplexes per variable and box).
 
     Examples
     --------
@@ -170,9 +175,12 @@ class CtcCentered(_Linearised):
     Interval([[0.5, 0.5], [0.5, 0.5]])
     """
 
-    def __init__(self, system: FunctionTape | Model, precondition: bool = True) -> None:
+    def __init__(self, system: FunctionTape | Model, precondition: bool | str = True) -> None:
         super().__init__(system)
-        self.precondition = bool(precondition)
+        if precondition not in (True, False, "gauss-jordan", "lp"):
+            raise ValueError(f"precondition must be True, False, 'gauss-jordan' or 'lp', got "
+                             f"{precondition!r}")
+        self.precondition = precondition
 
     def contract(self, x: Interval, targets: Interval | None = None) -> Interval:
         """Contract boxes ``(..., n)``; ``targets`` (broadcast to ``(..., m)``) replaces the
@@ -187,9 +195,13 @@ class CtcCentered(_Linearised):
             shape = (*x.shape[:-1], t.n_outputs)
             tl = np.broadcast_to(targets.lo, shape).reshape(len(lo), -1)
             th = np.broadcast_to(targets.hi, shape).reshape(len(lo), -1)
+        tl, th = np.ascontiguousarray(tl), np.ascontiguousarray(th)
         _centered_kernel(entries.lo, entries.hi, t.row_ptr, t.cols, fc.lo, fc.hi, values.lo,
-                         values.hi, np.ascontiguousarray(tl), np.ascontiguousarray(th), lo, hi,
-                         c, self.precondition)
+                         values.hi, tl, th, lo, hi, c, self.precondition in (True, "gauss-jordan"))
+        if self.precondition == "lp":
+            stats = np.zeros(len(WINDOW_STATS), dtype=np.int64)
+            batch_kernel(entries.lo, entries.hi, t.row_ptr, t.cols, fc.lo, fc.hi, tl, th, lo,
+                         hi, c, 20 * (t.n_outputs + self.n) + 200, stats)
         return _empty_rows(Interval._new(lo.reshape(x.shape), hi.reshape(x.shape)))
 
 

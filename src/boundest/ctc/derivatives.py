@@ -26,12 +26,13 @@ chain of local constraints costs the same per constraint however long it is.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numba as nb
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..expr.function_tape import FunctionTape
+from ..expr.function_tape import FunctionTape, as_function_tape
 from ..interval import Interval, as_interval
 from ..interval import algebraic as al
 from ..interval import arith as ar
@@ -372,9 +373,11 @@ def _args(tape: FunctionTape) -> tuple:
     return (tape.op, tape.out, tape.a, tape.b, tape.param)
 
 
-def evaluate(tape: FunctionTape, box: ArrayLike | Interval) -> Interval:
+def evaluate(tape: FunctionTape | Any, box: ArrayLike | Interval) -> Interval:
     """Natural interval extension of the tape's outputs over a box or a batch ``(..., n)``;
-    returns shape ``(..., m)``."""
+    returns shape ``(..., m)``. ``tape`` may also be an expression, a list of them, a model
+    or a list of constraints (``expr.function_tape.as_function_tape``)."""
+    tape = as_function_tape(tape)
     box = as_interval(box)
     lo, hi, batch = _slots(tape, box)
     forward_kernel(*_args(tape), lo, hi, *family_flags(tape.op))
@@ -388,6 +391,7 @@ def jacobian_sparse(tape: FunctionTape, box: ArrayLike | Interval, with_defined:
     pattern (row ``k`` holds columns ``tape.cols[tape.row_ptr[k]:tape.row_ptr[k + 1]]``); with
     ``with_defined`` also a boolean array ``(...)``: whether every primitive is defined and
     continuous on the box."""
+    tape = as_function_tape(tape)
     box = as_interval(box)
     lo, hi, batch = _slots(tape, box)
     nnz = len(tape.cols)
@@ -408,9 +412,13 @@ def _row_index(tape: FunctionTape) -> NDArray[np.int64]:
     return np.repeat(np.arange(tape.n_outputs), np.diff(tape.row_ptr))
 
 
-def jacobian(tape: FunctionTape, box: ArrayLike | Interval) -> tuple[Interval, Interval]:
+def jacobian(tape: FunctionTape | Any, box: ArrayLike | Interval) -> tuple[Interval, Interval]:
     """Natural values ``(..., m)`` and an enclosure of the Jacobian ``(..., m, n)`` over a box
     or a batch of boxes ``(..., n)``.
+
+    ``tape`` is a ``FunctionTape``, an expression or a list of them (columns: the variables in
+    order of first appearance; ``function_tape(..., names)`` fixes another order), or a model
+    or a list of constraints (the functions ``lhs - rhs``, columns ``Model.variable_names``).
 
     Every entry ``J[k, j]`` contains ``d f_k / d x_j`` at every point of the box where it
     exists (and, for non-smooth primitives, their generalized derivatives), so that
@@ -421,10 +429,11 @@ def jacobian(tape: FunctionTape, box: ArrayLike | Interval) -> tuple[Interval, I
     >>> from boundest.expr import Var
     >>> from boundest.expr.function_tape import function_tape
     >>> x, y = Var("x"), Var("y")
-    >>> _, J = jacobian(function_tape([x * y, x ** 2]), Interval([1, 2], [2, 3]))
+    >>> _, J = jacobian([x * y, x ** 2], Interval([1, 2], [2, 3]))
     >>> J.lo.tolist(), J.hi.tolist()
     ([[2.0, 1.0], [2.0, 0.0]], [[3.0, 2.0], [4.0, 0.0]])
     """
+    tape = as_function_tape(tape)
     values, entries = jacobian_sparse(tape, box)
     batch = values.shape[:-1]
     jl = np.zeros((*batch, tape.n_outputs, tape.n_vars))
@@ -435,16 +444,26 @@ def jacobian(tape: FunctionTape, box: ArrayLike | Interval) -> tuple[Interval, I
     return values, Interval._new(jl, jh)
 
 
-def centered(tape: FunctionTape, box: ArrayLike | Interval, center: ArrayLike | None = None
-             ) -> Interval:
+def centered(tape: FunctionTape | Any, box: ArrayLike | Interval,
+             center: ArrayLike | None = None) -> Interval:
     """Mean-value (centered) form of the outputs, intersected with the natural form.
 
     ``f(X) in f(c) + J(X) (X - c)`` with ``c`` the midpoint of the box (clamped into the box
     and finite where a bound is infinite) unless ``center`` is given; ``f(c)`` is evaluated
     rigorously as an interval. The centered form is quadratically close to the range as the
     box shrinks, the natural form only linearly; their intersection is never wider than either.
-    Returns shape ``(..., m)``.
+    Returns shape ``(..., m)``; ``tape`` as in :func:`jacobian`.
+
+    Examples
+    --------
+    >>> from boundest.expr import Var
+    >>> x = Var("x")
+    >>> box = Interval(0.4, 0.6)[None]
+    >>> natural, mean_value = evaluate(x * (1 - x), box), centered(x * (1 - x), box)
+    >>> round(float(natural.width()[0]), 3), round(float(mean_value.width()[0]), 3)
+    (0.2, 0.04)
     """
+    tape = as_function_tape(tape)
     box = as_interval(box)
     c = midpoint(box) if center is None else np.asarray(center, dtype=np.float64)
     if center is not None and not np.all(box.contains(c) | box.is_empty()):

@@ -37,7 +37,7 @@ from .linear_forms import _nan_hi, _nan_lo, _scale, _term
 from .revise import _div_hi, _div_lo
 from .simplex import LP_OPTIMAL, lp_setup, lp_solve, multipliers
 
-__all__ = ["WINDOW_STATS", "assign_targets", "contract_windows", "windows_kernel"]
+__all__ = ["WINDOW_STATS", "assign_targets", "batch_kernel", "contract_windows", "windows_kernel"]
 
 INF = math.inf
 _njit = nb.njit(cache=True, error_model="numpy")
@@ -251,6 +251,27 @@ def windows_kernel(el, eh, row_ptr, cols, fcl, fch, tl, th, xl, xh, c, win_lo, w
             if not xl[g] <= xh[g]:
                 return False
     return True
+
+
+@_njit
+def batch_kernel(el, eh, row_ptr, cols, fcl, fch, tl, th, xl, xh, c, max_iter, stats):
+    """:func:`windows_kernel` on each box of a batch (``(n_boxes, ...)`` arrays), with one
+    window holding every constraint and every variable a target; an empty box gets NaN
+    bounds."""
+    m = row_ptr.size - 1
+    n = xl.shape[1]
+    win_lo = np.zeros(1, dtype=np.int64)
+    win_hi = np.full(1, m, dtype=np.int64)
+    tptr = np.array([0, n], dtype=np.int64)
+    tvars = np.arange(n, dtype=np.int64)
+    for bx in range(xl.shape[0]):
+        if not np.all(xl[bx] <= xh[bx]) or m == 0:
+            continue
+        if not windows_kernel(el[bx], eh[bx], row_ptr, cols, fcl[bx], fch[bx], tl[bx], th[bx],
+                              xl[bx], xh[bx], c[bx], win_lo, win_hi, tptr, tvars, max_iter,
+                              stats):
+            xl[bx, :] = np.nan
+            xh[bx, :] = np.nan
 
 
 def assign_targets(tape: FunctionTape, targets: NDArray[np.int64], size: int, stride: int
