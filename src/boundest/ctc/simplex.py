@@ -124,10 +124,9 @@ def _dual_simplex(T, x, lb, ub, basis, nonbasic, c, max_iter):
         row, worst, up = -1, 0.0, False
         for i in range(m):
             v = basis[i]
-            scale = 1.0 + abs(lb[v]) + abs(ub[v])
-            if x[v] < lb[v] - _TOL * scale and lb[v] - x[v] > worst:
+            if x[v] < lb[v] - _TOL * (1.0 + abs(lb[v])) and lb[v] - x[v] > worst:
                 row, worst, up = i, lb[v] - x[v], True
-            elif x[v] > ub[v] + _TOL * scale and x[v] - ub[v] > worst:
+            elif x[v] > ub[v] + _TOL * (1.0 + abs(ub[v])) and x[v] - ub[v] > worst:
                 row, worst, up = i, x[v] - ub[v], False
         if row < 0:
             return LP_OPTIMAL
@@ -199,10 +198,11 @@ def _primal_simplex(T, x, lb, ub, basis, nonbasic, c, max_iter):
         for i in range(m):
             a = -T[i, col] * d  # d x_B[i] / dt
             v = basis[i]
-            tol = _TOL * (1.0 + abs(lb[v]) + abs(ub[v]))
             if a > ptol:
+                tol = _TOL * (1.0 + abs(ub[v]))
                 bound = min(bound, (max(ub[v] - x[v], 0.0) + tol) / a)
             elif a < -ptol:
+                tol = _TOL * (1.0 + abs(lb[v]))
                 bound = min(bound, (max(x[v] - lb[v], 0.0) + tol) / -a)
         if bound < tmax:
             best = 0.0

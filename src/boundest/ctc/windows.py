@@ -80,6 +80,16 @@ def _aggregate(y, Jl, Jh, gl, gh):
 
 
 @_njit
+def _clean(y, zl, zh):
+    """Zero the multipliers whose sign would make the lower end of ``y . s`` infinite (a row
+    bounded on one side only, with a multiplier of the wrong sign left by rounding in the
+    simplex): the bound the programme finds is on that end, and any ``y`` is sound."""
+    for q in range(y.size):
+        if (y[q] > 0.0 and zl[q] == -INF) or (y[q] < 0.0 and zh[q] == INF):
+            y[q] = 0.0
+
+
+@_njit
 def _narrow(i, y, zl, zh, gl, gh, dl, dh):
     """Contract ``d_i`` with the aggregated row (module docstring), in place. Returns -1 when
     the row proves that no solution is left, 1 when ``d_i`` narrowed, 0 otherwise."""
@@ -174,7 +184,14 @@ def windows_kernel(el, eh, row_ptr, cols, fcl, fch, tl, th, xl, xh, c, win_lo, w
             for k in range(n):
                 if Jl[q, k] != 0.0 or Jh[q, k] != 0.0:
                     e += 0.5 * (Jh[q, k] - Jl[q, k]) * max(abs(dl[k]), abs(dh[k]))
-            lb_s[q], ub_s[q] = _oracle_bound(zl[q] - e, zh[q] + e, wmax)
+            # a row's value never leaves the range of mid(J) d over the (clamped) box: an
+            # infinite side becomes that range, not a huge number
+            reach = 1.0
+            for k in range(n):
+                if A[q, k] != 0.0:
+                    reach += abs(A[q, k]) * max(abs(lb_d[k]), abs(ub_d[k]))
+            lb_s[q] = max(zl[q] - e, -reach)
+            ub_s[q] = min(zh[q] + e, reach)
         # the oracle's programme: a column that occurs in one row only and is no target is
         # folded into that row's bounds (exact for the programme, and its multipliers are
         # the same): on a chain that leaves the states, not the noises and measurements
@@ -238,6 +255,7 @@ def windows_kernel(el, eh, row_ptr, cols, fcl, fch, tl, th, xl, xh, c, win_lo, w
                 stats[1] += 1
                 y = multipliers(T, basis, obj, nl)
                 obj[o] = 0.0
+                _clean(y, zl, zh)
                 _aggregate(y, Jl, Jh, gl, gh)
                 res = _narrow(i, y, zl, zh, gl, gh, dl, dh)
                 if res < 0:
