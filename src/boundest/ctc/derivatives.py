@@ -451,6 +451,7 @@ def centered(tape: FunctionTape, box: ArrayLike | Interval, center: ArrayLike | 
     if center is not None and not np.all(box.contains(c) | box.is_empty()):
         raise ValueError("the center must lie in the box")
     natural, entries = jacobian_sparse(tape, box)
+    c = np.where(box.is_empty(), 0.0, c)  # an empty component: any centre, the result is empty
     fc = evaluate(tape, Interval(c, c))
     dx = box - Interval(c, c)
     rows = _row_index(tape)
