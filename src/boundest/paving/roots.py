@@ -111,6 +111,14 @@ def _merge(newton: CtcNewton, boxes: Interval) -> tuple[Interval, int]:
         for j in np.nonzero(meets[i, i + 1:])[0] + i + 1:
             if not keep[j]:
                 continue
+            if np.all((lo[i] <= lo[j]) & (hi[j] <= hi[i])) or np.all(
+                    (lo[j] <= lo[i]) & (hi[i] <= hi[j])):
+                # nested (e.g. the same point twice, from a root on a bisection face): the
+                # inner box's solution is the outer one's only solution
+                lo[i], hi[i] = np.maximum(lo[i], lo[j]), np.minimum(hi[i], hi[j])
+                keep[j] = False
+                merged += 1
+                continue
             h = Interval(np.minimum(lo[i], lo[j]), np.maximum(hi[i], hi[j]))
             hb, p = newton.prove(h[None, :])
             if p[0]:
