@@ -583,7 +583,10 @@ def check_one_sided(prim: Prim, box: Interval, pts) -> None:
 # per-primitive properties
 # -------------------------------------------------------------------------------------------
 
-FAST = settings(max_examples=25, deadline=None)
+#: the default run samples each primitive lightly (36 of them, times six properties); the slow
+#: run checks every property on many more boxes
+FAST = settings(max_examples=15, deadline=None)
+FASTER = settings(max_examples=10, deadline=None)
 SLOW = settings(max_examples=400, deadline=None)
 
 
@@ -611,7 +614,7 @@ def test_mean_value_property(name, data):
 
 
 @pytest.mark.parametrize("name", NAMES)
-@FAST
+@FASTER
 @given(data=st.data())
 def test_centered_form_contains_values(name, data):
     """Every primitive: natural and centered forms hold ``f`` at the sampled points, the
@@ -621,7 +624,7 @@ def test_centered_form_contains_values(name, data):
 
 
 @pytest.mark.parametrize("name", NAMES)
-@FAST
+@FASTER
 @given(data=st.data())
 def test_defined_is_never_claimed_falsely(name, data):
     """Every primitive: ``with_defined`` is False where the primitive is undefined or
@@ -630,7 +633,7 @@ def test_defined_is_never_claimed_falsely(name, data):
 
 
 @pytest.mark.parametrize("name", ["tan", "sign", "floor", "ceil", "atan2"])
-@FAST
+@FASTER
 @given(data=st.data())
 def test_jumps_give_unbounded_slopes(name, data):
     """Jumps (tan's poles, sign at 0, floor/ceil at the integers, atan2's branch cut): the
@@ -640,7 +643,7 @@ def test_jumps_give_unbounded_slopes(name, data):
 
 
 @pytest.mark.parametrize("name", ["abs", "min", "max", "add", "sub", "neg"])
-@FAST
+@FASTER
 @given(data=st.data())
 def test_kinks_one_sided_derivatives(name, data):
     """Piecewise-linear primitives: one-sided derivatives at sampled points (kinks among
@@ -751,11 +754,11 @@ def test_unbounded_boxes(name):
     mean-value property and contain the values at finite points."""
     prim = PRIMS[name]
     comps = [(-INF, INF), (0.0, INF), (-INF, 0.0), (1.0, INF), (-INF, -1.0)]
-    pts_of = {(-INF, INF): [0.0, 1.0, -3.0, 1e300], (0.0, INF): [0.0, 2.0, 1e300],
+    pts_of = {(-INF, INF): [0.0, -3.0, 1e300], (0.0, INF): [0.0, 2.0, 1e300],
               (-INF, 0.0): [0.0, -2.5, -1e300], (1.0, INF): [1.0, 7.0],
               (-INF, -1.0): [-1.0, -7.5]}
     for c0 in comps:
-        for c1 in (comps if prim.arity == 2 else [None]):
+        for c1 in (comps[:3] if prim.arity == 2 else [None]):
             cs = [c0] if c1 is None else [c0, c1]
             box = _box(*cs)
             pts = [tuple(p) for p in np.array(np.meshgrid(*[pts_of[c] for c in cs]))
@@ -944,7 +947,7 @@ def _composite_checks(t, box, pts, tape, which) -> None:
         assert not bool(ok), (t, box)
 
 
-COMPOSITE = settings(max_examples=150, deadline=None)
+COMPOSITE = settings(max_examples=100, deadline=None)
 
 
 @COMPOSITE

@@ -37,6 +37,10 @@ from boundest.expr.nodes import Expr, variables
 from boundest.paving.roots import solve_square
 
 from .strategies import CSP_VARS, _outward, expression_trees, tree_expr, tree_value
+from .test_derivatives import TooBigError, UndefinedError
+from .test_derivatives import tree_eval as wild_eval
+from .test_derivatives import tree_expr as wild_expr
+from .test_derivatives import trees as wild_trees
 
 INF = math.inf
 mpf = mpmath.mpf
@@ -77,28 +81,48 @@ def boxes_around(draw, x: tuple[float, ...], k: int) -> Interval:
     return Interval(lo, hi)
 
 
+def _wild_value(t, p):
+    """A wild tree's value at ``p`` (mpmath), or None where undefined or beyond 1e150."""
+    try:
+        return wild_eval(t, p)[0]
+    except (UndefinedError, TooBigError):
+        return None
+
+
 @st.composite
-def solved_systems(draw, square: bool = False):
-    """Constraints ``f_k(x) in T_k`` over ``x0..x{n-1}`` (random trees of +, -, *, sqr, sin,
-    cos and a / (1 + a^2)), a point ``x*`` in ``[-2, 2]^n`` and targets holding ``f_k(x*)``
-    (computed in mpmath, rounded outward): tight, widened, ``<=`` or ``>=``. Square systems
-    are ``x_k + f_k(x) in T_k`` (every variable present). Returns the constraints, the
-    tape-style targets, the variables and ``x*``."""
-    n = draw(st.integers(2, 3))
+def solved_systems(draw, square: bool = False, wild: bool = False):
+    """Constraints ``f_k(x) in T_k`` over ``x0..x{n-1}``, a point ``x*`` and targets holding
+    ``f_k(x*)`` (computed in mpmath, rounded outward): tight, widened, ``<=`` or ``>=``. The
+    trees are random polynomial / trig ones (+, -, *, sqr, sin, cos, a / (1 + a^2)), or with
+    ``wild`` of depth <= 3 over every primitive (tests/test_derivatives.py; ``x*`` then also
+    at special points, and inside every primitive's domain). Square systems are
+    ``x_k + f_k(x) in T_k`` (every variable present). Returns the constraints, the tape-style
+    targets, the variables and ``x*`` (in the variables' order)."""
+    n = 3 if wild else draw(st.integers(2, 3))
     m = n if square else draw(st.integers(1, n + 1))
-    trees = draw(st.lists(expression_trees(n, 6), min_size=m, max_size=m))
-    xs = tuple(draw(st.floats(-2, 2)) for _ in range(n))
-    exprs = [tree_expr(t) for t in trees]
+    if wild:
+        trees = draw(st.lists(wild_trees(3), min_size=m, max_size=m))
+        xs = tuple(draw(st.one_of(st.floats(-3, 3), st.sampled_from([0.0, 0.5, 1.0, -1.0])))
+                   for _ in range(n))
+        exprs = [wild_expr(t) for t in trees]
+        values = [_wild_value(t, xs) for t in trees]
+        assume(all(v is not None for v in values))
+    else:
+        trees = draw(st.lists(expression_trees(n, 6), min_size=m, max_size=m))
+        xs = tuple(draw(st.floats(-2, 2)) for _ in range(n))
+        exprs = [tree_expr(t) for t in trees]
+        values = [tree_value(t, xs) for t in trees]
     if square:
         exprs = [CSP_VARS[k] + e for k, e in enumerate(exprs)]
-    names = [v.name for v in variables([e for e in exprs if isinstance(e, Expr)])]
-    assume(len(names) == n or not square)
-    assume(names)
+        values = [None if v is None else v + mpf(xs[k]) for k, v in enumerate(values)]
+    # a constant tree (a number, an interval, a constant expression) constrains nothing
+    keep = [isinstance(e, Expr) and bool(variables([e])) for e in exprs]
+    names = [v.name for v in variables([e for e, k in zip(exprs, keep, strict=True) if k])]
+    assume(names and (len(names) == n or not square) and (all(keep) or not square))
     constraints, targets = [], []
-    for k, (t, e) in enumerate(zip(trees, exprs, strict=True)):
-        if not isinstance(e, Expr):  # a constant tree (a number or an interval)
+    for e, v, k in zip(exprs, values, keep, strict=True):
+        if not k:
             continue
-        v = tree_value(t, xs) + (mpf(xs[k]) if square else 0)
         lo, hi = _outward(v, False), _outward(v, True)
         kind = draw(st.sampled_from(["tight", "wide", "le", "ge"] if not square
                                     else ["tight", "wide"]))
@@ -114,14 +138,13 @@ def solved_systems(draw, square: bool = False):
         else:
             constraints.append(e.in_((lo, hi)))
             targets.append((lo, hi))
-    assume(constraints)
     point = {f"x{i}": xs[i] for i in range(n)}
     return constraints, targets, names, tuple(point[v] for v in names)
 
 
 @st.composite
-def centered_cases(draw, square: bool = False):
-    constraints, targets, names, xs = draw(solved_systems(square))
+def centered_cases(draw, square: bool = False, wild: bool = False):
+    constraints, targets, names, xs = draw(solved_systems(square, wild))
     boxes = draw(boxes_around(xs, draw(st.integers(1, 4))))
     return constraints, targets, names, xs, boxes
 
@@ -149,6 +172,14 @@ def check_centered_keeps_solution(constraints, targets, names, xs, boxes) -> Non
         for ctc in ctcs:
             _check_keeps(ctc, boxes, xs, (pre, type(ctc).__name__))
             _check_keeps(ctc, boxes[:1], xs, (pre, type(ctc).__name__))
+        # other data per box: the targets widened by a different amount for each box
+        k = len(boxes)
+        tg = Interval([t[0] for t in targets], [t[1] for t in targets])
+        grow = np.linspace(0.0, 1.0, k)[:, None]
+        per_box = Interval(tg.lo - grow, tg.hi + grow)
+        out = CtcCentered(tape, precondition=pre).contract(boxes, targets=per_box)
+        for i in range(k):
+            assert _float_in_box(xs, out[i]), ("per-box targets", boxes[i], out[i], xs)
 
 
 @settings(max_examples=40, deadline=None)
@@ -184,11 +215,23 @@ def test_ctc_newton_keeps_the_solution(case):
     check_newton_keeps_solution(constraints, names, xs, boxes)
 
 
+@settings(max_examples=25, deadline=None)
+@given(centered_cases(wild=True), centered_cases(square=True, wild=True))
+def test_contractors_keep_the_solution_of_wild_constraints(case, square_case):
+    """Constraints over every primitive (sqrt, log, asin, pow, atan2, floor, min, ...): the
+    centered contractors keep the known solution, whatever the domains and jumps."""
+    check_centered_keeps_solution(*case)
+    constraints, _, names, xs, boxes = square_case
+    check_newton_keeps_solution(constraints, names, xs, boxes)
+
+
 @pytest.mark.slow
 @settings(max_examples=600, deadline=None)
-@given(centered_cases(), centered_cases(square=True))
+@given(st.one_of(centered_cases(), centered_cases(wild=True)),
+       st.one_of(centered_cases(square=True), centered_cases(square=True, wild=True)))
 def test_centered_contractors_keep_the_solution_long(case, square_case):
-    """Many more random systems: CtcCentered and CtcNewton keep the known solution."""
+    """Many more random systems (polynomial / trig and wild): CtcCentered and CtcNewton keep
+    the known solution."""
     check_centered_keeps_solution(*case)
     constraints, _, names, xs, boxes = square_case
     check_newton_keeps_solution(constraints, names, xs, boxes)
