@@ -567,3 +567,31 @@ def test_solve_square_root_on_a_bisection_face_regression():
     sys = make_system(2, [-0.5, 0.5, -0.75], [-1.5], [], "zero", 1.0, "zero", 2, 0)
     check_solve(sys)
     assert int(solve_square(sys.model(), _search_box(sys), eps=1e-6).proved.sum()) == 3
+
+
+@pytest.mark.parametrize("extra", ["inequality", "domain"])
+def test_solve_square_other_constraints_regression(extra):
+    """``x^2 = 2, y = 1`` with ``x >= 1.4142135623730951`` (or that domain declared): no
+    solution, sqrt(2) = 1.41421356237309504... lies below the float. Hull consistency cannot
+    refute the point x = 1.4142135623730951 (x^2 rounds to [2, 2 + 4e-16]); a Newton proof
+    on a wider box (of the equations' root sqrt(2)) was kept through that contraction: the
+    point box was reported proved (it holds no solution at all), and on [0, 2]^2 the
+    inflated undecided box was proved with sqrt(2) outside the model. A proof now needs the
+    whole contracted box inside the other constraints and the declared domains."""
+    x, y = Var("x"), Var("y")
+    t = 1.4142135623730951
+    assert mpmath.sqrt(2) < t
+    m = Model().add(x ** 2 == 2, y == 1)
+    if extra == "inequality":
+        m.add(x >= t)
+    else:
+        m = Model(domains={"x": Interval(t, 2.0), "y": Interval(0.0, 2.0)},
+                  constraints=m.constraints)
+    for box in (Interval([1.4, 0.5], [1.5, 1.5]), Interval([0.0, 0.0], [2.0, 2.0])):
+        res = solve_square(m, box)
+        assert not res.proved.any(), (box, res.boxes)
+    # the same with a feasible bound: proved, the root inside the reported box
+    m = Model().add(x ** 2 == 2, y == 1, x >= 1.4142135623730949)
+    res = solve_square(m, Interval([0.0, 0.0], [2.0, 2.0]))
+    assert int(res.proved.sum()) == 1
+    assert mp_in_box((mpmath.sqrt(2), mpf(1)), res.solutions.lo[0], res.solutions.hi[0])
