@@ -11,7 +11,7 @@ solution of the system in the initial box lies in a proved or an undecided box.
 from __future__ import annotations
 
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -20,8 +20,8 @@ from numpy.typing import NDArray
 
 from ..ctc import CtcFwdBwd
 from ..ctc.centered import CtcNewton
-from ..ctc.derivatives import jacobian_sparse
-from ..expr.function_tape import constraint_functions
+from ..ctc.derivatives import evaluate, jacobian_sparse
+from ..expr.function_tape import _as_function, constraint_functions, function_tape
 from ..expr.model import Model
 from ..interval import Interval
 
@@ -74,18 +74,20 @@ def _nonempty(x: Interval) -> NDArray[np.bool_]:
     return ~np.isnan(x.lo).any(axis=-1)
 
 
-def _newton_rounds(newton: CtcNewton, hc4: CtcFwdBwd | None, x: Interval, rounds: int
+def _newton_rounds(newton: CtcNewton, hc4: CtcFwdBwd | None, x: Interval, rounds: int,
+                   inside: Callable[[Interval], NDArray[np.bool_]]
                    ) -> tuple[Interval, NDArray[np.bool_]]:
     """Alternate Newton and hull consistency while some box still shrinks by 10 %.
 
     Newton runs first on each box: hull consistency may leave a component degenerate (one
-    exact value), where the Krawczyk test has no room to prove anything; a proof found on a
-    box stays valid for every contraction of it."""
+    exact value), where the Krawczyk test has no room to prove anything. A proof counts where
+    the whole contracted box satisfies the other constraints (``inside``): its one solution of
+    the equations is then a solution of the model, which every later contraction keeps."""
     proved = np.zeros(len(x), dtype=np.bool_)
     for _ in range(rounds):
         before = x.width().max(axis=-1)
         x, p = newton.prove(x)
-        proved |= p & _nonempty(x)
+        proved |= p & _nonempty(x) & inside(x)
         if hc4 is not None:
             x = hc4(x)
         after = x.width().max(axis=-1)
@@ -93,6 +95,23 @@ def _newton_rounds(newton: CtcNewton, hc4: CtcFwdBwd | None, x: Interval, rounds
             if not np.any(after < 0.9 * before):
                 break
     return x, proved & _nonempty(x)
+
+
+def _inside(model: Model, names: list[str], domains: Interval
+            ) -> Callable[[Interval], NDArray[np.bool_]]:
+    """Per box, whether every point of it lies in the declared domains and satisfies the
+    model's constraints other than its equations (natural interval form)."""
+    others = [_as_function(c) for c in model.constraints if c.rel != "=="]
+    tape = function_tape([g for g, _, _ in others], names, [(a, b) for _, a, b in others])
+
+    def inside(x: Interval) -> NDArray[np.bool_]:
+        ok = np.all((x.lo >= domains.lo) & (x.hi <= domains.hi), axis=-1)
+        if others:
+            v = evaluate(tape, x)
+            ok &= np.all((v.lo >= tape.target_lo) & (v.hi <= tape.target_hi), axis=-1)
+        return ok
+
+    return inside
 
 
 def _merge(newton: CtcNewton, boxes: Interval) -> tuple[Interval, int]:
@@ -171,6 +190,7 @@ def solve_square(system: Model | Sequence, box: Interval | None = None, *, eps: 
         raise ValueError(f"eps must be positive, got {eps}")
     newton = CtcNewton(tape)
     hc4 = CtcFwdBwd(model, list(tape.names))
+    inside = _inside(model, list(tape.names), domains)
     frontier = box[None, :]
     proved_boxes: list[Interval] = []
     undecided: list[Interval] = []
@@ -179,7 +199,7 @@ def solve_square(system: Model | Sequence, box: Interval | None = None, *, eps: 
     stopped = "eps"
     while len(frontier):
         processed += len(frontier)
-        x, proved = _newton_rounds(newton, hc4, frontier, 8)
+        x, proved = _newton_rounds(newton, hc4, frontier, 8, inside)
         alive = _nonempty(x)
         proved_boxes.append(x[proved])
         x = x[alive & ~proved]
@@ -212,7 +232,7 @@ def solve_square(system: Model | Sequence, box: Interval | None = None, *, eps: 
     if len(und):
         rad = np.maximum(und.width(), eps) * 0.25
         infl = Interval(np.maximum(und.lo - rad, box.lo), np.minimum(und.hi + rad, box.hi))
-        ib, ip = _newton_rounds(newton, None, infl, 4)
+        ib, ip = _newton_rounds(newton, None, infl, 4, inside)
         if ip.any():
             sol = _cat([sol, ib[ip]], n)
             covers = _cat([covers, infl[ip]], n)
