@@ -490,23 +490,32 @@ def _search_box(sys: KnownSystem) -> Interval:
     return Interval(lo, hi)
 
 
-def check_solve(sys: KnownSystem, box: Interval | None = None, eps: float = 1e-6) -> None:
+def check_solve(sys: KnownSystem, box: Interval | None = None, eps: float = 1e-6,
+                cut: float | None = None) -> None:
     """solve_square: every root in the search box lies in a returned box; each proved box
     holds exactly one root, a simple one, and distinct proved boxes distinct roots;
-    mpmath.findroot from a proved box's midpoint (50 digits) converges inside it."""
+    mpmath.findroot from a proved box's midpoint (50 digits) converges inside it. With
+    ``cut``, the model also says ``u0 <= cut``: the roots beyond it are no solutions (a
+    proved box may hold none of them)."""
     box = _search_box(sys) if box is None else box
-    res = solve_square(sys.model(), box, eps=eps, max_boxes=3000)
+    model = sys.model()
+    if cut is not None:
+        model.add(Var("u0") <= cut)
+    res = solve_square(model, box, eps=eps, max_boxes=3000)
     lo, hi = res.boxes.lo, res.boxes.hi
     assert res.variables == [f"u{i}" for i in range(sys.n)]
+    feasible = [cut is None or r[0] <= cut for r in sys.roots]
     in_search = [q for q, r in enumerate(sys.roots) if mp_in_box(r, box.lo, box.hi)]
     for q in in_search:
-        assert any(mp_in_box(sys.roots[q], lo[i], hi[i]) for i in range(len(res))), (
+        assert not feasible[q] or any(mp_in_box(sys.roots[q], lo[i], hi[i])
+                                      for i in range(len(res))), (
             "root lost", sys.what, sys.roots[q], res)
     owner = {}
     for i in np.nonzero(res.proved)[0]:
         inside = [q for q, r in enumerate(sys.roots) if mp_in_box(r, lo[i], hi[i])]
         assert len(inside) == 1, ("false proof", sys.what, res.boxes[i], inside)
         assert sys.simple[inside[0]], ("proved a multiple root", sys.what, res.boxes[i])
+        assert feasible[inside[0]], ("proved a root beyond the cut", sys.what, cut)
         assert inside[0] not in owner, ("one root, two proved boxes", sys.what,
                                          res.boxes[owner[inside[0]]], res.boxes[i])
         owner[inside[0]] = i
@@ -517,26 +526,43 @@ def check_solve(sys: KnownSystem, box: Interval | None = None, eps: float = 1e-6
             slack = mpf(10) ** -40
             assert all(mpf(a) - slack <= v <= mpf(b) + slack
                        for v, a, b in zip(z, lo[i], hi[i], strict=True)), (sys.what, z)
-    if not any(sys.simple):
+    if not any(s and f for s, f in zip(sys.simple, feasible, strict=True)):
         assert not res.proved.any()
 
 
-@settings(max_examples=12, deadline=None)
-@given(known_systems())
-def test_solve_square_finds_and_proves(sys):
-    """solve_square on random systems with known roots (simple, double, close pairs, none)."""
-    check_solve(sys)
+@st.composite
+def cuts(draw, sys: KnownSystem):
+    """None mostly, else a bound on ``u0``: at a root's ``u0`` (rounded), a float next to it,
+    or anywhere."""
+    kind = draw(st.integers(0, 5))
+    if kind <= 2:
+        return None
+    if kind <= 4 and sys.roots:
+        v = float(draw(st.sampled_from(sys.roots))[0])
+        return v if kind == 3 else math.nextafter(v, draw(st.sampled_from([-INF, INF])))
+    return draw(st.floats(-3, 3))
+
+
+@settings(max_examples=20, deadline=None)
+@given(st.data())
+def test_solve_square_finds_and_proves(data):
+    """solve_square on random systems with known roots (simple, double, close pairs, none),
+    now and then with an inequality cutting through or next to a root."""
+    sys = data.draw(known_systems(), label="system")
+    check_solve(sys, cut=data.draw(cuts(sys), label="cut"))
 
 
 @pytest.mark.slow
-@settings(max_examples=200, deadline=None)
-@given(known_systems(), st.integers(0, 2))
-def test_solve_square_finds_and_proves_long(sys, where):
-    """solve_square, many more systems, also on a search box cutting through the roots."""
+@settings(max_examples=300, deadline=None)
+@given(st.data())
+def test_solve_square_finds_and_proves_long(data):
+    """solve_square, many more systems, inequalities, and search boxes cutting through the
+    roots."""
+    sys = data.draw(known_systems(), label="system")
     box = _search_box(sys)
-    if where == 1:  # a box whose faces pass through roots or near them
+    if data.draw(st.booleans()):  # a box whose faces pass through roots or near them
         box = Interval(box.lo, np.full(sys.n, 0.5))
-    check_solve(sys, box)
+    check_solve(sys, box, cut=data.draw(cuts(sys), label="cut"))
 
 
 @pytest.mark.parametrize("sys", [
