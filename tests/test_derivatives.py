@@ -945,6 +945,21 @@ def _composite_checks(t, box, pts, tape, which) -> None:
     if "defined" in which and any(v == "undefined" for v, _ in evals):
         _, _, ok = jacobian_sparse(tape, box, with_defined=True)
         assert not bool(ok), (t, box)
+    if "batch" in which:  # a batch (2, 2, n) gives each box what it gets alone
+        other = Interval(np.minimum(box.lo, -1.0), np.maximum(box.hi, 2.0))
+        batch = Interval(np.stack([np.stack([box.lo, other.lo]), np.stack([other.lo, box.lo])]),
+                         np.stack([np.stack([box.hi, other.hi]), np.stack([other.hi, box.hi])]))
+        bv, bj = jacobian(tape, batch)
+        ov, oj = jacobian(tape, other)
+        assert bj.shape == (2, 2, 2, N_VARS) and bv.shape == (2, 2, 2)
+        for (i, j), (v1, j1) in {(0, 0): (values, jac), (1, 1): (values, jac), (0, 1): (ov, oj),
+                                 (1, 0): (ov, oj)}.items():
+            np.testing.assert_array_equal(bj.lo[i, j], j1.lo)
+            np.testing.assert_array_equal(bj.hi[i, j], j1.hi)
+            np.testing.assert_array_equal(bv.lo[i, j], v1.lo)
+        cb = centered(tape, batch)
+        np.testing.assert_array_equal(cb.lo[0, 0], centered(tape, box).lo)
+        np.testing.assert_array_equal(cb.hi[1, 0], centered(tape, other).hi)
 
 
 COMPOSITE = settings(max_examples=100, deadline=None)
@@ -970,8 +985,9 @@ def test_composite_mean_value_property(case):
 @given(composites())
 def test_composite_centered_and_defined(case):
     """Random composite expressions: natural and centered forms hold the values, centered
-    inside natural; a point outside the domain means the box is not claimed defined."""
-    _composite_checks(*case, {"centered", "defined"})
+    inside natural; a point outside the domain means the box is not claimed defined; a batch
+    of boxes gets what each box gets alone."""
+    _composite_checks(*case, {"centered", "defined", "batch"})
 
 
 @pytest.mark.slow
@@ -979,7 +995,7 @@ def test_composite_centered_and_defined(case):
 @given(composites())
 def test_composite_properties_long(case):
     """Random composite expressions, many more: every composite property above."""
-    _composite_checks(*case, {"gradient", "mean_value", "centered", "defined"})
+    _composite_checks(*case, {"gradient", "mean_value", "centered", "defined", "batch"})
 
 
 # -------------------------------------------------------------------------------------------
