@@ -11,7 +11,11 @@ boundest.paving.roots).
   roots, pairs of roots closer than the box, and systems without a real root are never proved.
 - ``solve_square``: every root lies in a returned box, each proved box holds exactly one root,
   distinct proved boxes distinct roots, and ``mpmath.findroot`` from a proved box's midpoint
-  (50 digits) converges inside it.
+  (50 digits) converges inside it; with an inequality or a domain cutting a root off, that
+  root is never proved.
+
+Regression cases kept: a root on a bisection face reported twice, a proof kept through a
+contraction by the other constraints, and false proofs from swapped atan2 derivatives.
 """
 
 from __future__ import annotations
@@ -621,3 +625,30 @@ def test_solve_square_other_constraints_regression(extra):
     res = solve_square(m, Interval([0.0, 0.0], [2.0, 2.0]))
     assert int(res.proved.sum()) == 1
     assert mp_in_box((mpmath.sqrt(2), mpf(1)), res.solutions.lo[0], res.solutions.hi[0])
+
+
+@pytest.mark.parametrize(("theta", "a", "b", "c", "lo", "hi"), [
+    (-0.2994083225038464, -0.5, -2.0, 1.0, [8.518948120084008, -2.6299282363615286],
+     [8.519220561564577, -2.6296557948809594]),
+    (1.8620411048180596, -2.0, 0.5, 1.0, [-0.2838701692426068, 0.8750776112526567],
+     [-0.26006674593254664, 0.8988810345627168]),
+])
+def test_newton_atan2_regression(theta, a, b, c, lo, hi):
+    """``atan2(y, x) = theta, a x + b y = c`` (one root, on the ray at angle theta): with the
+    partial derivatives of atan2 swapped (tests/test_derivatives.py), Krawczyk's test passed
+    on these boxes, which miss the root: a false proof of existence. Boxes around the root
+    are proved."""
+    x, y = Var("x"), Var("y")
+    tape = function_tape([bd.atan2(y, x), a * x + b * y], [x, y], [(theta, theta), (c, c)])
+    t = c / (a * mpmath.cos(theta) + b * mpmath.sin(theta))
+    root = (t * mpmath.cos(theta), t * mpmath.sin(theta))
+    assert t > 0 and not mp_in_box(root, lo, hi)
+    sys = KnownSystem(2, lambda u, m: [m.atan2(u[1], u[0]) - theta, a * u[0] + b * u[1] - c],
+                      [root], [True], "atan2")
+    box = Interval(lo, hi)[None, :]
+    newton = CtcNewton(tape)
+    for _ in range(3):
+        box, proved = newton.prove(box)
+        assert not proved.any(), box
+    c0 = np.array([float(v) for v in root])
+    assert check_prove(sys, Interval(c0 - 1e-6, c0 + 1e-6)[None, :]) >= 1
