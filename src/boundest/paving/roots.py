@@ -114,8 +114,9 @@ def _inside(model: Model, names: list[str], domains: Interval
     return inside
 
 
-def _merge(newton: CtcNewton, boxes: Interval) -> tuple[Interval, int]:
-    """Proved boxes that overlap and whose hull is proved to hold one solution are one."""
+def _merge(newton: CtcNewton, boxes: Interval, eps: float) -> tuple[Interval, int]:
+    """Proved boxes that overlap and whose hull (or the hull inflated by a quarter of its
+    width, at least ``eps / 4``) is proved to hold one solution are one."""
     k = len(boxes)
     if k < 2:
         return boxes, 0
@@ -140,8 +141,13 @@ def _merge(newton: CtcNewton, boxes: Interval) -> tuple[Interval, int]:
                 continue
             h = Interval(np.minimum(lo[i], lo[j]), np.maximum(hi[i], hi[j]))
             hb, p = newton.prove(h[None, :])
-            if p[0]:
-                lo[i], hi[i] = hb.lo[0], hb.hi[0]
+            if not p[0]:  # a hull a few ulps wide leaves Krawczyk no room beyond rounding
+                rad = np.maximum(h.width(), eps) * 0.25
+                hb, p = newton.prove(Interval(h.lo - rad, h.hi + rad)[None, :])
+            if p[0]:  # one solution in the hull: the same in both boxes, so in both
+                nl = np.maximum(np.maximum(lo[i], lo[j]), hb.lo[0])
+                nh = np.minimum(np.minimum(hi[i], hi[j]), hb.hi[0])
+                lo[i], hi[i] = (nl, nh) if np.all(nl <= nh) else (hb.lo[0], hb.hi[0])
                 keep[j] = False
                 merged += 1
     return Interval(lo[keep], hi[keep]), merged
@@ -236,7 +242,7 @@ def solve_square(system: Model | Sequence, box: Interval | None = None, *, eps: 
         if ip.any():
             sol = _cat([sol, ib[ip]], n)
             covers = _cat([covers, infl[ip]], n)
-    sol, merged = _merge(newton, sol)
+    sol, merged = _merge(newton, sol, eps)
     why = np.concatenate(reasons) if reasons else np.empty(0, dtype="<U13")
     if len(und):  # an undecided box inside a proved one holds no other solution
         inside = np.zeros(len(und), dtype=np.bool_)
