@@ -75,19 +75,19 @@ def _nonempty(x: Interval) -> NDArray[np.bool_]:
 
 
 def _newton_rounds(newton: CtcNewton, hc4: CtcFwdBwd | None, x: Interval, rounds: int,
-                   inside: Callable[[Interval], NDArray[np.bool_]]
+                   in_model: Callable[[Interval], NDArray[np.bool_]]
                    ) -> tuple[Interval, NDArray[np.bool_]]:
     """Alternate Newton and hull consistency while some box still shrinks by 10 %.
 
     Newton runs first on each box: hull consistency may leave a component degenerate (one
     exact value), where the Krawczyk test has no room to prove anything. A proof counts where
-    the whole contracted box satisfies the other constraints (``inside``): its one solution of
+    the whole contracted box satisfies the other constraints (``in_model``): its one solution of
     the equations is then a solution of the model, which every later contraction keeps."""
     proved = np.zeros(len(x), dtype=np.bool_)
     for _ in range(rounds):
         before = x.width().max(axis=-1)
         x, p = newton.prove(x)
-        proved |= p & _nonempty(x) & inside(x)
+        proved |= p & _nonempty(x) & in_model(x)
         if hc4 is not None:
             x = hc4(x)
         after = x.width().max(axis=-1)
@@ -196,7 +196,7 @@ def solve_square(system: Model | Sequence, box: Interval | None = None, *, eps: 
         raise ValueError(f"eps must be positive, got {eps}")
     newton = CtcNewton(tape)
     hc4 = CtcFwdBwd(model, list(tape.names))
-    inside = _inside(model, list(tape.names), domains)
+    in_model = _inside(model, list(tape.names), domains)
     frontier = box[None, :]
     proved_boxes: list[Interval] = []
     undecided: list[Interval] = []
@@ -205,7 +205,7 @@ def solve_square(system: Model | Sequence, box: Interval | None = None, *, eps: 
     stopped = "eps"
     while len(frontier):
         processed += len(frontier)
-        x, proved = _newton_rounds(newton, hc4, frontier, 8, inside)
+        x, proved = _newton_rounds(newton, hc4, frontier, 8, in_model)
         alive = _nonempty(x)
         proved_boxes.append(x[proved])
         x = x[alive & ~proved]
@@ -238,7 +238,7 @@ def solve_square(system: Model | Sequence, box: Interval | None = None, *, eps: 
     if len(und):
         rad = np.maximum(und.width(), eps) * 0.25
         infl = Interval(np.maximum(und.lo - rad, box.lo), np.minimum(und.hi + rad, box.hi))
-        ib, ip = _newton_rounds(newton, None, infl, 4, inside)
+        ib, ip = _newton_rounds(newton, None, infl, 4, in_model)
         if ip.any():
             sol = _cat([sol, ib[ip]], n)
             covers = _cat([covers, infl[ip]], n)
