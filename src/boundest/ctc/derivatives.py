@@ -163,14 +163,15 @@ def _slopes_other(code, zl, zh, xl, xh, yl, yh, p, buf):
         ll, lh = _f_log(xl, xh, math.log(xl), math.log(xh))
         sbl, sbh = _mul(ll, lh, zl, zh)
         return sal, sah, sbl, sbh
-    if code == ATAN2:  # atan2(y, x) with y = a, x = b: (x, -y) / (x^2 + y^2)
-        # around the origin (no angle) or across the branch cut (x < 0, y = 0 from below)
-        if (yl <= 0.0 <= yh and xl <= 0.0 <= xh) or (xl < 0.0 and yl < 0.0 <= yh):
+    if code == ATAN2:  # atan2(y, x): y = a is (xl, xh) here, x = b is (yl, yh)
+        # d/dy = x / (x^2 + y^2), d/dx = -y / (x^2 + y^2); entire around the origin (no
+        # angle) or across the branch cut (x < 0, y = 0 from below)
+        if (xl <= 0.0 <= xh and yl <= 0.0 <= yh) or (yl < 0.0 and xl < 0.0 <= xh):
             return -INF, INF, -INF, INF
         rl = _add_lo(_sqr_lo(yl, yh), _sqr_hi(yl, yh), _sqr_lo(xl, xh), _sqr_hi(xl, xh))
         rh = _add_hi(_sqr_lo(yl, yh), _sqr_hi(yl, yh), _sqr_lo(xl, xh), _sqr_hi(xl, xh))
-        sal, sah = _div(xl, xh, rl, rh)
-        sbl, sbh = _div(-yh, -yl, rl, rh)
+        sal, sah = _div(yl, yh, rl, rh)
+        sbl, sbh = _div(-xh, -xl, rl, rh)
         return sal, sah, sbl, sbh
     return -INF, INF, -INF, INF
 
@@ -261,8 +262,8 @@ def defined(code, zl, zh, xl, xh, yl, yh, p):
         return p >= 0.0 or not xl <= 0.0 <= xh
     if code == POW:
         return xl > 0.0 or (xl >= 0.0 and yl > 0.0)
-    if code == ATAN2:
-        return not ((yl <= 0.0 <= yh and xl <= 0.0 <= xh) or (xl < 0.0 and yl < 0.0 <= yh))
+    if code == ATAN2:  # atan2(y, x) with y = a (xl, xh), x = b (yl, yh)
+        return not ((xl <= 0.0 <= xh and yl <= 0.0 <= yh) or (yl < 0.0 and xl < 0.0 <= xh))
     if code == TAN:
         return zl > -INF and zh < INF
     if code == SIGN:
@@ -469,6 +470,7 @@ def centered(tape: FunctionTape | Any, box: ArrayLike | Interval,
     if center is not None and not np.all(box.contains(c) | box.is_empty()):
         raise ValueError("the center must lie in the box")
     natural, entries = jacobian_sparse(tape, box)
+    c = np.where(box.is_empty(), 0.0, c)  # an empty component: any centre, the result is empty
     fc = evaluate(tape, Interval(c, c))
     dx = box - Interval(c, c)
     rows = _row_index(tape)

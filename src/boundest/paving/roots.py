@@ -11,7 +11,7 @@ solution of the system in the initial box lies in a proved or an undecided box.
 from __future__ import annotations
 
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -20,8 +20,8 @@ from numpy.typing import NDArray
 
 from ..ctc import CtcFwdBwd
 from ..ctc.centered import CtcNewton
-from ..ctc.derivatives import jacobian_sparse
-from ..expr.function_tape import constraint_functions
+from ..ctc.derivatives import evaluate, jacobian_sparse
+from ..expr.function_tape import _as_function, constraint_functions, function_tape
 from ..expr.model import Model
 from ..interval import Interval
 
@@ -74,18 +74,20 @@ def _nonempty(x: Interval) -> NDArray[np.bool_]:
     return ~np.isnan(x.lo).any(axis=-1)
 
 
-def _newton_rounds(newton: CtcNewton, hc4: CtcFwdBwd | None, x: Interval, rounds: int
+def _newton_rounds(newton: CtcNewton, hc4: CtcFwdBwd | None, x: Interval, rounds: int,
+                   in_model: Callable[[Interval], NDArray[np.bool_]]
                    ) -> tuple[Interval, NDArray[np.bool_]]:
     """Alternate Newton and hull consistency while some box still shrinks by 10 %.
 
     Newton runs first on each box: hull consistency may leave a component degenerate (one
-    exact value), where the Krawczyk test has no room to prove anything; a proof found on a
-    box stays valid for every contraction of it."""
+    exact value), where the Krawczyk test has no room to prove anything. A proof counts where
+    the whole contracted box satisfies the other constraints (``in_model``): its one solution of
+    the equations is then a solution of the model, which every later contraction keeps."""
     proved = np.zeros(len(x), dtype=np.bool_)
     for _ in range(rounds):
         before = x.width().max(axis=-1)
         x, p = newton.prove(x)
-        proved |= p & _nonempty(x)
+        proved |= p & _nonempty(x) & in_model(x)
         if hc4 is not None:
             x = hc4(x)
         after = x.width().max(axis=-1)
@@ -95,8 +97,26 @@ def _newton_rounds(newton: CtcNewton, hc4: CtcFwdBwd | None, x: Interval, rounds
     return x, proved & _nonempty(x)
 
 
-def _merge(newton: CtcNewton, boxes: Interval) -> tuple[Interval, int]:
-    """Proved boxes that overlap and whose hull is proved to hold one solution are one."""
+def _inside(model: Model, names: list[str], domains: Interval
+            ) -> Callable[[Interval], NDArray[np.bool_]]:
+    """Per box, whether every point of it lies in the declared domains and satisfies the
+    model's constraints other than its equations (natural interval form)."""
+    others = [_as_function(c) for c in model.constraints if c.rel != "=="]
+    tape = function_tape([g for g, _, _ in others], names, [(a, b) for _, a, b in others])
+
+    def inside(x: Interval) -> NDArray[np.bool_]:
+        ok = np.all((x.lo >= domains.lo) & (x.hi <= domains.hi), axis=-1)
+        if others:
+            v = evaluate(tape, x)
+            ok &= np.all((v.lo >= tape.target_lo) & (v.hi <= tape.target_hi), axis=-1)
+        return ok
+
+    return inside
+
+
+def _merge(newton: CtcNewton, boxes: Interval, eps: float) -> tuple[Interval, int]:
+    """Proved boxes that overlap and whose hull (or the hull inflated by a quarter of its
+    width, at least ``eps / 4``) is proved to hold one solution are one."""
     k = len(boxes)
     if k < 2:
         return boxes, 0
@@ -111,10 +131,23 @@ def _merge(newton: CtcNewton, boxes: Interval) -> tuple[Interval, int]:
         for j in np.nonzero(meets[i, i + 1:])[0] + i + 1:
             if not keep[j]:
                 continue
+            if np.all((lo[i] <= lo[j]) & (hi[j] <= hi[i])) or np.all(
+                    (lo[j] <= lo[i]) & (hi[i] <= hi[j])):
+                # nested (e.g. the same point twice, from a root on a bisection face): the
+                # inner box's solution is the outer one's only solution
+                lo[i], hi[i] = np.maximum(lo[i], lo[j]), np.minimum(hi[i], hi[j])
+                keep[j] = False
+                merged += 1
+                continue
             h = Interval(np.minimum(lo[i], lo[j]), np.maximum(hi[i], hi[j]))
             hb, p = newton.prove(h[None, :])
-            if p[0]:
-                lo[i], hi[i] = hb.lo[0], hb.hi[0]
+            if not p[0]:  # a hull a few ulps wide leaves Krawczyk no room beyond rounding
+                rad = np.maximum(h.width(), eps) * 0.25
+                hb, p = newton.prove(Interval(h.lo - rad, h.hi + rad)[None, :])
+            if p[0]:  # one solution in the hull: the same in both boxes, so in both
+                nl = np.maximum(np.maximum(lo[i], lo[j]), hb.lo[0])
+                nh = np.minimum(np.minimum(hi[i], hi[j]), hb.hi[0])
+                lo[i], hi[i] = (nl, nh) if np.all(nl <= nh) else (hb.lo[0], hb.hi[0])
                 keep[j] = False
                 merged += 1
     return Interval(lo[keep], hi[keep]), merged
@@ -163,6 +196,7 @@ def solve_square(system: Model | Sequence, box: Interval | None = None, *, eps: 
         raise ValueError(f"eps must be positive, got {eps}")
     newton = CtcNewton(tape)
     hc4 = CtcFwdBwd(model, list(tape.names))
+    in_model = _inside(model, list(tape.names), domains)
     frontier = box[None, :]
     proved_boxes: list[Interval] = []
     undecided: list[Interval] = []
@@ -171,7 +205,7 @@ def solve_square(system: Model | Sequence, box: Interval | None = None, *, eps: 
     stopped = "eps"
     while len(frontier):
         processed += len(frontier)
-        x, proved = _newton_rounds(newton, hc4, frontier, 8)
+        x, proved = _newton_rounds(newton, hc4, frontier, 8, in_model)
         alive = _nonempty(x)
         proved_boxes.append(x[proved])
         x = x[alive & ~proved]
@@ -204,11 +238,11 @@ def solve_square(system: Model | Sequence, box: Interval | None = None, *, eps: 
     if len(und):
         rad = np.maximum(und.width(), eps) * 0.25
         infl = Interval(np.maximum(und.lo - rad, box.lo), np.minimum(und.hi + rad, box.hi))
-        ib, ip = _newton_rounds(newton, None, infl, 4)
+        ib, ip = _newton_rounds(newton, None, infl, 4, in_model)
         if ip.any():
             sol = _cat([sol, ib[ip]], n)
             covers = _cat([covers, infl[ip]], n)
-    sol, merged = _merge(newton, sol)
+    sol, merged = _merge(newton, sol, eps)
     why = np.concatenate(reasons) if reasons else np.empty(0, dtype="<U13")
     if len(und):  # an undecided box inside a proved one holds no other solution
         inside = np.zeros(len(und), dtype=np.bool_)
