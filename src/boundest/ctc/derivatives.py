@@ -488,7 +488,8 @@ def centered(tape: FunctionTape | Any, box: ArrayLike | Interval,
 def midpoint(box: Interval) -> NDArray[np.float64]:
     """A finite point of each box: the midpoint, 0 or a finite bound where one is infinite."""
     lo, hi = box.lo, box.hi
-    c = 0.5 * lo + 0.5 * hi
+    with np.errstate(invalid="ignore"):  # inf - inf where both bounds are infinite: replaced
+        c = 0.5 * lo + 0.5 * hi
     c = np.where(np.isfinite(lo) & np.isfinite(hi), c,
                  np.where(np.isfinite(lo), lo, np.where(np.isfinite(hi), hi, 0.0)))
     return np.clip(c, lo, hi)
