@@ -754,13 +754,15 @@ def run_newton(a) -> dict:
                 for _ in range(a.repeat):
                     t0 = time.perf_counter()
                     x = box
+                    proved_any = np.zeros(len(lo), bool)
                     for _ in range(k):
                         x, proved = newton.prove(x)
+                        proved_any |= proved
                     times.append(time.perf_counter() - t0)
                 t = statistics.median(times)
                 row["boundest"][f"steps_{k}"] = {
                     "time_s": t, "us_per_box": 1e6 * t / len(lo),
-                    "proved_unique": int(proved.sum()),
+                    "proved_last_step": int(proved.sum()), "proved_any_step": int(proved_any.sum()),
                     **summarize_side(x.lo, x.hi, lo, hi, sol),
                     **lost(x.lo, x.hi, sol, elo, ehi)}
                 row["boundest"][f"steps_{k}"]["_bounds"] = (x.lo, x.hi)
@@ -784,7 +786,7 @@ def run_newton(a) -> dict:
             b1, b5 = row["boundest"]["steps_1"], row["boundest"]["steps_5"]
             s = (f"newton {name} rel={rel:g}: 1 step {b1['us_per_box']:.2f} us/box mean max "
                  f"{b1['mean_max_width']:.3g}, 5 steps {b5['mean_max_width']:.3g} proved "
-                 f"{b5['proved_unique']}")
+                 f"{b5['proved_any_step']} (last step {b5['proved_last_step']})")
             if row["codac"]:
                 s += "; codac " + ", ".join(
                     f"{mo} {r['us_per_box']:.1f} us/box mean max {r['mean_max_width']:.3g}"
@@ -833,6 +835,76 @@ def first_use() -> dict:
     return res
 
 
+def _g(v, fmt: str = ".3g") -> str:
+    return "-" if v is None else format(v, fmt)
+
+
+def tables(doc: dict) -> str:
+    """The Markdown tables of the README from a result document."""
+    lines = []
+    rows = doc.get("centered", {}).get("rows", {})
+    main = "fwdbwd+centered_P"
+    if rows:
+        lines += ["| problem | rel. radius | boundest µs/box | Codac µs/box | Codac / boundest "
+                  "time | median width ratio per component | mean max-width ratio | wider | "
+                  "narrower | lost (boundest / Codac) |", "|---|---|---:|---:|---:|---|---:|"
+                  "---:|---:|---|"]
+        for r in rows.values():
+            b, c = r["boundest"][main], r["codac"].get("default")
+            v = r["vs_codac"].get(main)
+            if not (c and v):
+                continue
+            med = ", ".join(f"{x:.3f}" for x in v["median_width_ratio"])
+            lines.append(f"| {r['problem']} | {r['rel_radius']:g} | {b['us_per_box']:.1f} | "
+                         f"{c['us_per_box']:.1f} | {v['time_ratio_codac_over_boundest']:.1f} | "
+                         f"{med} | {v['mean_max_width_ratio']:.3f} | {v['frac_wider']:.3f} | "
+                         f"{v['frac_narrower']:.3f} | {b['lost']} / {c['lost']} |")
+        lines += ["", "| problem | rel. radius | " + " | ".join(VARIANTS) + " |",
+                  "|---|---|" + "---|" * len(VARIANTS)]
+        for r in rows.values():
+            if not r["vs_codac"]:
+                continue
+            cells = []
+            for vname in VARIANTS:
+                v = r["vs_codac"][vname]
+                cells.append(f"{v['mean_max_width_ratio']:.3f} / {v['frac_wider']:.2f} / "
+                             f"{v['frac_narrower']:.2f} / x{v['time_ratio_codac_over_boundest']:.1f}")
+            lines.append(f"| {r['problem']} | {r['rel_radius']:g} | " + " | ".join(cells)
+                         + " |")
+        diag = [r for r in rows.values() if "diagnosis" in r]
+        if diag:
+            keys = [k for k in diag[0]["diagnosis"] if isinstance(diag[0]["diagnosis"][k], dict)]
+            lines += ["", "| problem | rel. radius | " + " | ".join(keys) + " |",
+                      "|---|---|" + "---|" * len(keys)]
+            for r in diag:
+                d = r["diagnosis"]
+                lines.append(f"| {r['problem']} | {r['rel_radius']:g} | " + " | ".join(
+                    f"{d[k]['mean_max_width_ratio']:.3f} / {d[k]['frac_wider']:.2f}"
+                    for k in keys) + " |")
+    nrows = doc.get("newton", {}).get("rows", {})
+    if nrows:
+        lines += ["", "| system | rel. radius | boundest 1 step: µs/box, mean max width | "
+                  "5 steps: µs/box, mean max width, proved | Codac one step | Codac default "
+                  "(iterated) | lost (boundest 5 / Codac) |", "|---|---|---|---|---|---|---|"]
+        for r in nrows.values():
+            b1, b5 = r["boundest"]["steps_1"], r["boundest"]["steps_5"]
+            c1, cd = r["codac"].get("one_step"), r["codac"].get("default")
+            lines.append(
+                f"| {r['problem']} | {r['rel_radius']:g} | {b1['us_per_box']:.1f}, "
+                f"{b1['mean_max_width']:.3g} | {b5['us_per_box']:.1f}, {b5['mean_max_width']:.3g},"
+                f" {b5['proved_any_step']}/{r['boxes']} | "
+                + (f"{c1['us_per_box']:.1f}, {c1['mean_max_width']:.3g} | "
+                   f"{cd['us_per_box']:.1f}, {cd['mean_max_width']:.3g} | "
+                   f"{b5['lost']} / {c1['lost']}, {cd['lost']} |" if c1 and cd else "- | - | - |"))
+    fu = doc.get("first_use")
+    if fu:
+        lines += ["", "first use (fresh process): " + "; ".join(
+            f"{k}: import {v['import_s']:.2f} s, CtcCentered first call "
+            f"{v['centered_first_call_s']:.2f} s, CtcFwdBwd first call "
+            f"{v['fwdbwd_first_call_s']:.2f} s" for k, v in fu.items())]
+    return "\n".join(lines)
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--out", help="also write the JSON here")
@@ -848,7 +920,11 @@ def main() -> int:
     ap.add_argument("--diagnose", type=int, default=1000,
                     help="boxes per batch for the sweep replay (0: none)")
     ap.add_argument("--quick", action="store_true", help="1,000 boxes, 2 repeats")
+    ap.add_argument("--table", metavar="JSON", help="only print the tables of a result file")
     a = ap.parse_args()
+    if a.table:
+        print(tables(json.loads(Path(a.table).read_text())))
+        return 0
     if a.quick:
         a.n, a.newton_n, a.repeat, a.codac_repeat, a.diagnose = 1000, 500, 2, 1, 200
 
@@ -877,6 +953,7 @@ def main() -> int:
     doc["loadavg_end"] = os.getloadavg()
     doc["summary"] = summary(doc) if "centered" in doc else {}
     emit(doc, a.out)
+    log(tables(doc))
     return 0
 
 
