@@ -867,8 +867,9 @@ def tables(doc: dict) -> str:
             cells = []
             for vname in VARIANTS:
                 v = r["vs_codac"][vname]
+                t = v["time_ratio_codac_over_boundest"]
                 cells.append(f"{v['mean_max_width_ratio']:.3f} / {v['frac_wider']:.2f} / "
-                             f"{v['frac_narrower']:.2f} / x{v['time_ratio_codac_over_boundest']:.1f}")
+                             f"{v['frac_narrower']:.2f} / x{t:.1f}")
             lines.append(f"| {r['problem']} | {r['rel_radius']:g} | " + " | ".join(cells)
                          + " |")
         diag = [r for r in rows.values() if "diagnosis" in r]
