@@ -540,6 +540,32 @@ def sweep_replay(prob: Problem, lo: np.ndarray, hi: np.ndarray, order: tuple[str
     return olo, ohi
 
 
+def jacobian_compare(prob: Problem, lo, hi, cjac: dict) -> dict:
+    """boundest's Jacobian enclosure (reverse-mode slopes) against Codac's ``f.diff`` (forward
+    mode) entry by entry on the same boxes: interval products are not associative, so the two
+    chain rules give different enclosures."""
+    from boundest import Interval
+    from boundest.ctc.centered import CtcCentered
+    from boundest.ctc.derivatives import jacobian
+
+    m, _ = bd_model(prob.exprs, prob.t_lo, prob.t_hi)
+    _, jac = jacobian(CtcCentered(m).tape, Interval(lo, hi))
+    k, mm, n = jac.lo.shape
+    c_lo = np.array([float.fromhex(v) for v in cjac["lo"]]).reshape(k, mm, n)
+    c_hi = np.array([float.fromhex(v) for v in cjac["hi"]]).reshape(k, mm, n)
+    wb, wc = jac.hi - jac.lo, c_hi - c_lo
+    live = (wc > 0) | (wb > 0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.where(wc > 0, wb / wc, np.inf)
+    contains = (jac.lo <= c_lo) & (c_hi <= jac.hi)
+    return {"entries": int(live.sum()),
+            "frac_wider": float((wb > wc * (1 + REL_TOL))[live].mean()),
+            "frac_narrower": float((wb < wc * (1 - REL_TOL))[live].mean()),
+            "median_width_ratio": float(np.median(ratio[live])) if live.any() else None,
+            "frac_boundest_contains_codac": float(contains[live].mean()),
+            "boxes_any_entry_wider": float((wb > wc * (1 + REL_TOL)).any((1, 2)).mean())}
+
+
 def diagnose(prob: Problem, lo, hi, c_lo, c_hi, ctcs: dict) -> dict:
     """Each sweep order, with ``Y`` and with ``f(X) & Y``, alone and after ``CtcFwdBwd``,
     against Codac's default on the same boxes; ``replay_matches_centered_P``: the replay of
@@ -596,7 +622,7 @@ def run_centered(probs: list[Problem], a) -> dict:
     if not a.no_codac and CODAC2_PY.exists():
         spec = {"repeat": a.codac_repeat, "problems": [
             {"name": p.name, "n": p.n, "exprs": p.exprs, "t_lo": _hex(p.t_lo),
-             "t_hi": _hex(p.t_hi), "modes": ["default", "hc4"],
+             "t_hi": _hex(p.t_hi), "modes": ["default", "hc4"], "jacobian_boxes": a.diagnose,
              "batches": [{"key": f"{rel:g}", "lo": _hex(b[0]), "hi": _hex(b[1])}
                          for rel, b in batches[p.name].items()]} for p in probs]}
         log("codac 2 ...")
@@ -625,7 +651,8 @@ def run_centered(probs: list[Problem], a) -> dict:
             if codac is not None:
                 cb = codac["problems"][pi]["batches"][f"{rel:g}"]
                 cres = {}
-                for mode, rec in cb.items():
+                for mode in ("default", "hc4"):
+                    rec = cb[mode]
                     c_lo, c_hi = _unhex(rec["lo"], prob.n), _unhex(rec["hi"], prob.n)
                     cres[mode] = (c_lo, c_hi)
                     row["codac"][mode] = {"time_s": rec["contract_s"],
@@ -646,6 +673,9 @@ def run_centered(probs: list[Problem], a) -> dict:
                 sel = np.r_[0:k - k // 10, int(sol.sum()):int(sol.sum()) + k // 10]
                 row["diagnosis"] = diagnose(prob, lo[sel], hi[sel], cres["default"][0][sel],
                                             cres["default"][1][sel], ctcs)
+                if "jacobian" in cb:
+                    row["diagnosis"]["jacobian_vs_codac"] = jacobian_compare(
+                        prob, lo[:k], hi[:k], cb["jacobian"])
             rows[key] = row
             log(_row_line(row))
     out["rows"] = rows
@@ -874,7 +904,8 @@ def tables(doc: dict) -> str:
                          + " |")
         diag = [r for r in rows.values() if "diagnosis" in r]
         if diag:
-            keys = [k for k in diag[0]["diagnosis"] if isinstance(diag[0]["diagnosis"][k], dict)]
+            keys = [k for k, v in diag[0]["diagnosis"].items()
+                    if isinstance(v, dict) and "mean_max_width_ratio" in v]
             lines += ["", "| problem | rel. radius | " + " | ".join(keys) + " |",
                       "|---|---|" + "---|" * len(keys)]
             for r in diag:
@@ -882,6 +913,15 @@ def tables(doc: dict) -> str:
                 lines.append(f"| {r['problem']} | {r['rel_radius']:g} | " + " | ".join(
                     f"{d[k]['mean_max_width_ratio']:.3f} / {d[k]['frac_wider']:.2f}"
                     for k in keys) + " |")
+    jac = [r for r in rows.values() if "jacobian_vs_codac" in r.get("diagnosis", {})]
+    if jac:
+        lines += ["", "| problem | rel. radius | Jacobian entries: median width ratio | wider | "
+                  "narrower | boxes with a wider entry |", "|---|---|---:|---:|---:|---:|"]
+        for r in jac:
+            j = r["diagnosis"]["jacobian_vs_codac"]
+            lines.append(f"| {r['problem']} | {r['rel_radius']:g} | "
+                         f"{_g(j['median_width_ratio'], '.4f')} | {j['frac_wider']:.2f} | "
+                         f"{j['frac_narrower']:.2f} | {j['boxes_any_entry_wider']:.2f} |")
     nrows = doc.get("newton", {}).get("rows", {})
     if nrows:
         lines += ["", "| system | rel. radius | boundest 1 step: µs/box, mean max width | "

@@ -14,7 +14,9 @@ literals: the same strings build boundest's model), ``t_lo``, ``t_hi`` (the targ
 each expression), ``modes`` (``default``: ``CtcInverse(f, y)``, Codac's default, a forward
 evaluation, the centered step, then the backward evaluation; ``hc4``:
 ``CtcInverse(f, y, False)``, forward-backward only), ``batches``: a list of ``key``, ``lo``,
-``hi`` (boxes, flat row-major, ``N x n``).
+``hi`` (boxes, flat row-major, ``N x n``); optional ``jacobian_boxes`` (``k``: also write
+``f.diff`` -- Codac's Jacobian enclosure, forward mode -- on the first ``k`` boxes of each
+batch, flat ``k x m x n``).
 
 Each mode and batch: the boxes are built as ``IntervalVector`` before the clock starts (a fresh
 copy per run), then ``ctc.contract(box)`` is called on each in a Python loop (``contract_s``:
@@ -108,6 +110,16 @@ def main() -> None:
                      f"{med:.3f} s ({1e6 * med / max(1, len(rows)):.1f} us/box)")
                 brec[mode] = {"contract_s": med, "contract_times_s": times,
                               "build_contract_s": build_s, "lo": olo, "hi": ohi}
+            k = min(int(prob.get("jacobian_boxes", 0)), len(rows))
+            if k:  # Codac's Jacobian enclosure (forward mode) on the first k input boxes
+                jlo, jhi = [], []
+                for r in rows[:k]:
+                    jac = f.diff(IntervalVector(r))
+                    for i in range(jac.rows()):
+                        for j in range(jac.cols()):
+                            jlo.append(_h(jac(i, j).lb()))
+                            jhi.append(_h(jac(i, j).ub()))
+                brec["jacobian"] = {"lo": jlo, "hi": jhi}
             rec["batches"][batch["key"]] = brec
         out_problems.append(rec)
 
