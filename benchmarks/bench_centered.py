@@ -440,6 +440,9 @@ def compare(b_lo, b_hi, c_lo, c_hi) -> dict:
     narrower[both] = (wb[both] < wc[both] * (1 - REL_TOL)).any(1)
     wider |= ~eb & ec
     narrower |= eb & ~ec
+    with np.errstate(divide="ignore", invalid="ignore"):
+        excess = (wb[both] - wc[both]) / wc[both]
+    excess = excess[wb[both] > wc[both] * (1 + REL_TOL)]
     mb = np.where(eb, 0.0, np.nan_to_num(wb, nan=0.0).max(1))
     mc = np.where(ec, 0.0, np.nan_to_num(wc, nan=0.0).max(1))
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -452,6 +455,8 @@ def compare(b_lo, b_hi, c_lo, c_hi) -> dict:
         "frac_wider": float(wider.mean()), "frac_narrower": float(narrower.mean()),
         "frac_mixed": float((wider & narrower).mean()),
         "n_wider": int(wider.sum()), "n_narrower": int(narrower.sum()),
+        "wider_components_median_excess": float(np.median(excess)) if excess.size else 0.0,
+        "wider_components_max_excess": float(np.max(excess)) if excess.size else 0.0,
     }
 
 
@@ -515,7 +520,8 @@ def sweep_replay(prob: Problem, lo: np.ndarray, hi: np.ndarray, order: tuple[str
         zh = np.array([sub_up(a, f) for a, f in zip(yh, fc.lo[b], strict=True)])
         dl = np.array([sub_dn(lo[b, j], c[b, j]) for j in range(n)])
         dh = np.array([sub_up(hi[b, j], c[b, j]) for j in range(n)])
-        mid = np.where(np.isfinite(jl) & np.isfinite(jh), 0.5 * jl + 0.5 * jh, 0.0)
+        with np.errstate(invalid="ignore"):
+            mid = np.where(np.isfinite(jl) & np.isfinite(jh), 0.5 * jl + 0.5 * jh, 0.0)
         P, _ = preconditioner(mid)
         ml, mh = point_times(P, jl, jh)
         rl, rh = point_times(P, zl.reshape(-1, 1), zh.reshape(-1, 1))
@@ -826,6 +832,59 @@ def run_newton(a) -> dict:
 
 
 # ---------------------------------------------------------------------------------------------
+# where the time goes
+
+
+def breakdown(probs: list[Problem], a) -> dict:
+    """Per problem (boxes at ``rel = 1e-2``) and for Broyden's system under ``CtcNewton``: the
+    medians of the parts of one call, in µs per box: the Jacobian kernel over the boxes
+    (``jacobian_sparse``, which also gives the natural values), the natural evaluation at the
+    centres (``evaluate`` on degenerate boxes), the whole ``contract`` (the rest is the
+    row-contraction kernel and glue), and ``CtcFwdBwd`` (one vectorised pass per tape node)."""
+    from boundest import Interval
+    from boundest.ctc.centered import CtcNewton
+    from boundest.ctc.derivatives import evaluate, jacobian_sparse, midpoint
+
+    def med(fn) -> float:
+        fn()
+        times = []
+        for _ in range(a.repeat):
+            t0 = time.perf_counter()
+            fn()
+            times.append(time.perf_counter() - t0)
+        return statistics.median(times)
+
+    out = {}
+    cases = []
+    for i, prob in enumerate(probs):
+        lo, hi, *_ = boxes_for(prob, 1e-2, a.n, seed=100 * i + 1)
+        ctcs = bd_contractors(prob)
+        cases.append((prob.name, ctcs["centered_P"], Interval(lo, hi), ctcs["fwdbwd"]))
+    name, exprs, _, _, n = newton_problems()[1]
+    m, _ = bd_model(exprs, np.zeros(n), np.zeros(n))
+    rng = np.random.default_rng(5)
+    c0 = rng.uniform(-0.7, -0.4, (a.newton_n, n))
+    cases.append((f"{name} (CtcNewton)", CtcNewton(m), Interval(c0 - 0.01, c0 + 0.01), None))
+    for name, ctc, box, fb in cases:
+        k = box.shape[0]
+        c = midpoint(box)
+        rec = {"boxes": k, "tape_nodes": len(ctc.tape.op), "n": ctc.n,
+               "m": ctc.tape.n_outputs,
+               "contract": med(lambda ctc=ctc, box=box: ctc.contract(box)),
+               "jacobian_sparse": med(lambda ctc=ctc, box=box: jacobian_sparse(
+                   ctc.tape, box, with_defined=True)),
+               "evaluate_centres": med(lambda ctc=ctc, c=c: evaluate(ctc.tape, Interval(c, c)))}
+        if fb is not None:
+            rec["fwdbwd"] = med(lambda fb=fb, box=box: fb(box))
+        rec = {key: (1e6 * v / k if isinstance(v, float) else v) for key, v in rec.items()}
+        rec["rest"] = rec["contract"] - rec["jacobian_sparse"] - rec["evaluate_centres"]
+        out[name] = rec
+        log(f"breakdown {name}: " + ", ".join(f"{key} {v:.2f}" for key, v in rec.items()
+                                                if isinstance(v, float)) + " us/box")
+    return out
+
+
+# ---------------------------------------------------------------------------------------------
 # first use
 
 FIRST_USE = """
@@ -877,8 +936,8 @@ def tables(doc: dict) -> str:
     if rows:
         lines += ["| problem | rel. radius | boundest µs/box | Codac µs/box | Codac / boundest "
                   "time | median width ratio per component | mean max-width ratio | wider | "
-                  "narrower | lost (boundest / Codac) |", "|---|---|---:|---:|---:|---|---:|"
-                  "---:|---:|---|"]
+                  "median excess where wider | narrower | lost (boundest / Codac) |",
+                  "|---|---|---:|---:|---:|---|---:|---:|---:|---:|---|"]
         for r in rows.values():
             b, c = r["boundest"][main], r["codac"].get("default")
             v = r["vs_codac"].get(main)
@@ -888,6 +947,7 @@ def tables(doc: dict) -> str:
             lines.append(f"| {r['problem']} | {r['rel_radius']:g} | {b['us_per_box']:.1f} | "
                          f"{c['us_per_box']:.1f} | {v['time_ratio_codac_over_boundest']:.1f} | "
                          f"{med} | {v['mean_max_width_ratio']:.3f} | {v['frac_wider']:.3f} | "
+                         f"{v['wider_components_median_excess']:.2g} | "
                          f"{v['frac_narrower']:.3f} | {b['lost']} / {c['lost']} |")
         lines += ["", "| problem | rel. radius | " + " | ".join(VARIANTS) + " |",
                   "|---|---|" + "---|" * len(VARIANTS)]
@@ -937,6 +997,16 @@ def tables(doc: dict) -> str:
                 + (f"{c1['us_per_box']:.1f}, {c1['mean_max_width']:.3g} | "
                    f"{cd['us_per_box']:.1f}, {cd['mean_max_width']:.3g} | "
                    f"{b5['lost']} / {c1['lost']}, {cd['lost']} |" if c1 and cd else "- | - | - |"))
+    brk = doc.get("breakdown_us_per_box")
+    if brk:
+        lines += ["", "| problem | n, m, tape nodes | contract | jacobian_sparse | evaluate at "
+                  "centres | rest (row kernel, glue) | CtcFwdBwd |", "|---|---|---:|---:|---:|"
+                  "---:|---:|"]
+        for name, r in brk.items():
+            lines.append(f"| {name} | {r['n']}, {r['m']}, {r['tape_nodes']} | "
+                         f"{r['contract']:.2f} | {r['jacobian_sparse']:.2f} | "
+                         f"{r['evaluate_centres']:.2f} | {r['rest']:.2f} | "
+                         f"{_g(r.get('fwdbwd'), '.2f')} |")
     fu = doc.get("first_use")
     if fu:
         lines += ["", "first use (fresh process): " + "; ".join(
@@ -958,6 +1028,7 @@ def main() -> int:
     ap.add_argument("--no-newton", action="store_true")
     ap.add_argument("--no-first-use", action="store_true")
     ap.add_argument("--no-centered", action="store_true")
+    ap.add_argument("--no-breakdown", action="store_true")
     ap.add_argument("--diagnose", type=int, default=1000,
                     help="boxes per batch for the sweep replay (0: none)")
     ap.add_argument("--quick", action="store_true", help="1,000 boxes, 2 repeats")
@@ -989,6 +1060,8 @@ def main() -> int:
         doc["centered"] = run_centered(probs, a)
     if not a.no_newton:
         doc["newton"] = run_newton(a)
+    if not a.no_breakdown:
+        doc["breakdown_us_per_box"] = breakdown(probs, a)
     if not a.no_first_use:
         doc["first_use"] = first_use()
     doc["loadavg_end"] = os.getloadavg()
