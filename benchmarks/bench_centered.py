@@ -25,7 +25,10 @@ no solution). One contraction per box on each side.
   ``centered_P`` (``precondition=True``: plus Gauss-Jordan preconditioned rows), ``fwdbwd``
   (``CtcFwdBwd``, HC4-revise), ``fwdbwd+centered_P`` (the two in sequence, the counterpart of
   Codac's ``CtcInverse``), ``centered_P+fwdbwd`` (the other order, Codac's: centered step, then
-  the backward sweep);
+  the backward sweep), ``fwdbwd+centered_P[fX&Y]`` (the centered step with the targets
+  ``f(X) & Y``, Codac's right-hand side, through ``CtcCentered.contract(x, targets=...)``) and
+  ``fwdbwd+centered_P+centered_P`` (a second centered step, re-linearised on the contracted
+  box);
 * Codac 2.x (``centered_codac2.py`` in ``.bench-venv-codac2/``, a subprocess): ``default``
   (``CtcInverse(f, y)``: forward evaluation, ``f(X)`` intersected with ``y``, the centered
   step on ``f(X) & y - f(mid)`` with its ``MulOp::bwd`` -- Gauss-Jordan preconditioned rows
@@ -49,6 +52,14 @@ enclosure in some component.
 Interval Newton (``CtcNewton``, k steps) against Codac 1.5.7's ``CtcNewton``
 (``newton_codac1.py`` in ``.bench-venv-codac1/``): two circles ``x^2 + y^2 = 4``,
 ``(x - 1)^2 + y^2 = 2`` and Broyden's banded function with 10 unknowns, boxes around roots.
+
+Diagnosis (``--diagnose`` boxes per batch, default 1,000): the centered step replayed box by
+box with boundest's own Jacobian, centre and row kernel (``contract_rows``) but other orders of
+the row sweeps (``basic,P``: boundest's; ``P_rev,P,basic``: Codac 2.1.2's ``MulOp::bwd`` for
+``m <= n``: the Gauss-Jordan preconditioned rows last to first, first to last, then the rows of
+``J``; ``P,P,P,basic``), with ``Y`` or ``f(X) & Y``, alone or after ``CtcFwdBwd``; and Codac's
+Jacobian enclosure (``f.diff``, forward mode) against boundest's (reverse-mode slopes).
+Breakdown: the parts of one ``CtcCentered`` / ``CtcNewton`` call in µs per box.
 
 First use: the first call of ``CtcCentered`` in a fresh process with an empty
 ``NUMBA_CACHE_DIR`` (and ``BOUNDEST_KERNEL_ARCHIVE=0``: everything compiles), then with that
