@@ -21,7 +21,8 @@ user who reads nothing gets), and a few settings (``Centered(window=...)``, chea
 the satellite scenario's own settings).
 
 Per problem and variant: the mean width of each state family over the steps (and the widest
-state), the median propagation time of ``--repeat`` warm runs (``Propagation.time_s``), the
+state), the median propagation time of ``--repeat`` warm runs (``Propagation.time_s``; the
+variants of a problem take turns, one run each per round), the
 ratio of the width to the best variant's on that problem (the worst over the state families),
 the ratio of the time to ``hc4``'s in the same run, and whether the truth lies in every state's
 domain (the problem's own data, and ``--seeds`` more simulated data sets, one run each; the
@@ -520,9 +521,13 @@ def _counters(res) -> dict:
     return out
 
 
-def measure(p: Problem, label: str, mode: str, kw: dict, repeat: int, seeds: list[int]) -> dict:
-    """Warm-up, then ``repeat`` timed runs on the problem's compiled tape; then one run per
-    seed of re-simulated data (soundness)."""
+def measure(p: Problem, runs: list[tuple[str, str, dict]], repeat: int, seeds: list[int],
+            slow_seeds: bool = False) -> list[dict]:
+    """The variants ``runs`` (label, mode, keyword arguments) on one problem: a warm-up of
+    each, then ``repeat`` rounds in which every variant runs once (round robin, so that a
+    change of the machine's load falls on every variant alike; the slow ones run in the first
+    round only), on the problem's compiled tape; then one run per seed of re-simulated data
+    (soundness; the slow variants only with ``slow_seeds``)."""
     from boundest.csp import propagate
     from boundest.expr.tape import compile_model
 
@@ -531,38 +536,51 @@ def measure(p: Problem, label: str, mode: str, kw: dict, repeat: int, seeds: lis
         t0 = time.perf_counter()
         tape = p.extra["_tape"] = compile_model(p.model)
         p.extra["compile_model_s"] = time.perf_counter() - t0
-    slow = label in SLOW
-    if not slow:
-        propagate(tape, mode=mode, progress=False, **kw)
-    runs, walls = [], []
-    for _ in range(1 if slow else repeat):
-        t0 = time.perf_counter()
-        res = propagate(tape, mode=mode, progress=False, **kw)
-        walls.append(time.perf_counter() - t0)
-        runs.append(res.time_s)
-    fams = _widths(res, p)
-    row = {"problem": p.name, "variant": label, "mode": mode, "settings": _settings(kw),
-           "time_s": statistics.median(runs), "times_s": runs,
-           "wall_s": statistics.median(walls), "consistent": res.consistent,
-           "widths": fams,
-           "mean_width_states": float(np.mean([f["mean"] for f in fams.values()])),
-           "max_width_states": float(np.max([f["max"] for f in fams.values()])),
-           "evaluations": res.evaluations, "counters": _counters(res),
-           "truth_inside": _inside(res, p.truth)}
-    if p.truth is not None and not row["truth_inside"]:
-        row["outside"] = _outside(res, p.truth)
-    sound = {}
-    if p.resimulate is not None:
-        for s in seeds:
-            model, truth = p.resimulate(s)
-            r = propagate(compile_model(model), mode=mode, progress=False,
-                          **_rebind(kw, p, model))
-            sound[str(s)] = _inside(r, truth)
-            if not sound[str(s)]:
-                row.setdefault("outside_seeds", {})[str(s)] = (
-                    _outside(r, truth) if r.consistent else ["proven inconsistent"])
-    row["truth_inside_seeds"] = sound
-    return row
+    for label, mode, kw in runs:
+        if label not in SLOW:
+            propagate(tape, mode=mode, progress=False, **kw)
+    times: dict[str, list[float]] = {label: [] for label, _, _ in runs}
+    walls: dict[str, list[float]] = {label: [] for label, _, _ in runs}
+    last = {}
+    for rep in range(repeat):
+        for label, mode, kw in runs:
+            if label in SLOW and rep > 0:
+                continue
+            t0 = time.perf_counter()
+            last[label] = propagate(tape, mode=mode, progress=False, **kw)
+            walls[label].append(time.perf_counter() - t0)
+            times[label].append(last[label].time_s)
+    rows = []
+    for label, mode, kw in runs:
+        res = last[label]
+        fams = _widths(res, p)
+        row = {"problem": p.name, "variant": label, "mode": mode, "settings": _settings(kw),
+               "time_s": statistics.median(times[label]), "times_s": times[label],
+               "wall_s": statistics.median(walls[label]), "consistent": res.consistent,
+               "widths": fams,
+               "mean_width_states": float(np.mean([f["mean"] for f in fams.values()])),
+               "max_width_states": float(np.max([f["max"] for f in fams.values()])),
+               "evaluations": res.evaluations, "counters": _counters(res),
+               "truth_inside": _inside(res, p.truth)}
+        if p.truth is not None and not row["truth_inside"]:
+            row["outside"] = _outside(res, p.truth)
+        sound = {}
+        if p.resimulate is not None and (label not in SLOW or slow_seeds):
+            for s in seeds:
+                model, truth = p.resimulate(s)
+                r = propagate(compile_model(model), mode=mode, progress=False,
+                              **_rebind(kw, p, model))
+                sound[str(s)] = _inside(r, truth)
+                if not sound[str(s)]:
+                    row.setdefault("outside_seeds", {})[str(s)] = (
+                        _outside(r, truth) if r.consistent else ["proven inconsistent"])
+        row["truth_inside_seeds"] = sound
+        rows.append(row)
+        print(f"{p.name} | {label}: {row['time_s']:.4f} s, mean width "
+              f"{row['mean_width_states']:.4g}, max {row['max_width_states']:.4g}, "
+              f"truth {row['truth_inside']} {row['truth_inside_seeds']}",
+              file=sys.stderr, flush=True)
+    return rows
 
 
 def _rebind(kw: dict, p: Problem, model) -> dict:
@@ -815,15 +833,8 @@ def main() -> None:
                           "truth_known": prob.truth is not None,
                           "build_s": time.perf_counter() - t0,
                           **{k: v for k, v in prob.extra.items() if not k.startswith("_")}}
-            for label, mode, make in labels:
-                kw = make(prob)
-                use = prob.resimulate is not None and (label not in SLOW or args.slow_seeds)
-                row = measure(prob, label, mode, kw, args.repeat, seeds if use else [])
-                rows.append(row)
-                print(f"{name} | {label}: {row['time_s']:.4f} s, mean width "
-                      f"{row['mean_width_states']:.4g}, max {row['max_width_states']:.4g}, "
-                      f"truth {row['truth_inside']} {row['truth_inside_seeds']}",
-                      file=sys.stderr, flush=True)
+            runs = [(label, mode, make(prob)) for label, mode, make in labels]
+            rows += measure(prob, runs, args.repeat, seeds, args.slow_seeds)
             meta[name]["compile_model_s"] = prob.extra.get("compile_model_s")
             meta[name]["multi_occurrence_variables"] = (len(prob.extra["_multi"])
                                                         if "_multi" in prob.extra else None)
