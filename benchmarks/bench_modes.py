@@ -845,7 +845,9 @@ def main() -> None:
     old = {}
     if args.update and args.out and Path(args.out).exists():
         old = _floats(json.loads(Path(args.out).read_text()))
-        meta = {**old.get("problems", {}), **meta}
+        meta = {k: {**old.get("problems", {}).get(k, {}),
+                    **{a: b for a, b in meta.get(k, {}).items() if b is not None}}
+                for k in {**old.get("problems", {}), **meta}}
         if compile_rec is None:
             compile_rec = old.get("compile")
     key = "scaling" if args.scaling else "rows"
