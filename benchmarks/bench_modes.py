@@ -23,19 +23,21 @@ the satellite scenario's own settings).
 Per problem and variant: the mean width of each state family over the steps (and the widest
 state), the median propagation time of ``--repeat`` warm runs (``Propagation.time_s``; the
 variants of a problem take turns, one run each per round), the
-ratio of the width to the best variant's on that problem (the worst over the state families),
+ratio of the width to the best of the seven modes at their default settings on that problem
+(the worst over the state families),
 the ratio of the time to ``hc4``'s in the same run, and whether the truth lies in every state's
 domain (the problem's own data, and ``--seeds`` more simulated data sets, one run each; the
 satellite on ``satellite.simulate(200, seed)``). ``--compile`` adds the Numba compile time a
 user pays on the first use of each mode (a fresh ``NUMBA_CACHE_DIR`` per mode,
 ``BOUNDEST_KERNEL_ARCHIVE=0``, one subprocess each).
 
-Usage (the whole run, without ``--compile``, is about 20 min on a loaded 2-core machine; parts
-merge into the JSON with ``--update``)::
+Usage (the table without ``lp``: about 12 min on a loaded 2-core machine; ``lp``: 15 min more,
+``--compile``: 10 min more; parts merge into the JSON with ``--update``; ``--report`` prints
+the tables of benchmarks/README.md section 16 from the JSON)::
 
     flock /tmp/bench.lock .venv/bin/python benchmarks/bench_modes.py \\
         --out benchmarks/results/modes.json [--problems REGEX] [--variants REGEX] \\
-        [--repeat 5] [--seeds 2] [--update] [--compile]
+        [--repeat 5] [--seeds 1,2] [--update] [--compile] [--scaling] [--report]
 """
 
 from __future__ import annotations
