@@ -7,9 +7,10 @@ others (cheaper, tighter), ``bc`` (box consistency of the states, ``mode="bc"``)
 ``lp`` (LP contraction of the linear rows at the fixed point, ``mode="lp"``, side by side with
 ``csp.linear.propagate_lp``, which restarts hull consistency after each LP), ``lp + relax`` (the
 LPs also over the linear relaxation of the nonlinear nodes around the box,
-``LinearRelaxation(relax=True)``) and ``3b`` then ``lp + relax`` from its box, ``centered`` and ``3b+centered`` (the centered form
-of windows of steps with optimal multipliers, ``mode="3b+centered"`` with the settings of
-``boundest run satellite``, and variants), on the embedded data
+``LinearRelaxation(relax=True)``) and ``3b`` then ``lp + relax`` from its box, ``centered``
+and ``3b+centered`` (the centered form of windows of steps with optimal multipliers,
+``mode="3b+centered"`` with the settings of ``boundest run satellite``, and variants), on the
+embedded data
 at k_max = 200 (``satellite_k200.csv``) and 800
 (``satellite_k800.csv``). Per mode and data set: the median propagation time over ``--repeat``
 runs after a warm-up, the mean width of each state component over k = 0..k_max, the widest x1
