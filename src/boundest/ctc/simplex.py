@@ -121,7 +121,7 @@ def _dual_simplex(T, x, lb, ub, basis, nonbasic, c, max_iter):
     _reduced_costs(T, c, basis, nonbasic, r)
     for _ in range(max_iter):
         # leaving: the most infeasible basic variable
-        row, worst, up = -1, 0.0, False
+        row, worst, up = np.int64(-1), 0.0, False
         for i in range(m):
             v = basis[i]
             if x[v] < lb[v] - _TOL * (1.0 + abs(lb[v])) and lb[v] - x[v] > worst:
@@ -147,7 +147,7 @@ def _dual_simplex(T, x, lb, ub, basis, nonbasic, c, max_iter):
             inc = nonbasic[j] == 0  # at its lower bound: x_j may only increase
             if (a > 0.0) == (inc == up):
                 bound = min(bound, (abs(r[j]) + _DTOL) / abs(a))
-        col, step = -1, 0.0
+        col, step = np.int64(-1), 0.0
         for j in range(nt):
             if nonbasic[j] < 0 or ub[j] - lb[j] <= 0.0:
                 continue
@@ -179,7 +179,7 @@ def _primal_simplex(T, x, lb, ub, basis, nonbasic, c, max_iter):
     r = np.empty(nt)
     _reduced_costs(T, c, basis, nonbasic, r)
     for _ in range(max_iter):
-        col, best, d = -1, _TOL, 1.0
+        col, best, d = np.int64(-1), _TOL, 1.0
         for j in range(nt):
             if nonbasic[j] < 0 or ub[j] - lb[j] <= 0.0:
                 continue
@@ -189,7 +189,7 @@ def _primal_simplex(T, x, lb, ub, basis, nonbasic, c, max_iter):
                 col, best, d = j, r[j], -1.0
         if col < 0:
             return LP_OPTIMAL
-        tmax, row = ub[col] - lb[col], -1
+        tmax, row = ub[col] - lb[col], np.int64(-1)
         amax = 0.0
         for i in range(m):
             amax = max(amax, abs(T[i, col]))

@@ -51,7 +51,7 @@ _CLAMP = 1e8
 def _window_columns(row_ptr, cols, r0, r1, loc, colbuf):
     """The variables of rows ``r0 .. r1 - 1`` in order of first appearance, with ``loc``
     (global -> local index, -1 elsewhere) set for them; returns their count."""
-    n = 0
+    n = np.int64(0)
     for p in range(row_ptr[r0], row_ptr[r1]):
         j = cols[p]
         if loc[j] < 0:
@@ -108,7 +108,7 @@ def _narrow(i, y, zl, zh, gl, gh, dl, dh):
         return 0
     nl = _div_lo(rl, rh, gl[i], gh[i])
     nh = _div_hi(rl, rh, gl[i], gh[i])
-    moved = 0
+    moved = np.int64(0)
     if nl > dl[i]:
         dl[i] = nl
         moved = 1
@@ -203,7 +203,7 @@ def windows_kernel(el, eh, row_ptr, cols, fcl, fch, tl, th, xl, xh, c, win_lo, w
         lpcol = np.full(n, -1, dtype=np.int64)
         for t in range(tptr[w], tptr[w + 1]):
             lpcol[loc[tvars[t]]] = 0
-        nl = 0
+        nl = np.int64(0)
         for k in range(n):
             if cnt[k] >= 2 or lpcol[k] == 0:
                 lpcol[k] = nl
@@ -232,7 +232,7 @@ def windows_kernel(el, eh, row_ptr, cols, fcl, fch, tl, th, xl, xh, c, win_lo, w
         gl = np.empty(n)
         gh = np.empty(n)
         lp_setup(A_lp, lb_lp, ub_lp, lb_s, ub_s, T, x, lb, ub, basis, nonbasic)
-        first = True
+        first = np.int64(1)
         feasible = True
         for t in range(tptr[w], tptr[w + 1]):
             i = loc[tvars[t]]
@@ -249,9 +249,9 @@ def windows_kernel(el, eh, row_ptr, cols, fcl, fch, tl, th, xl, xh, c, win_lo, w
                         feasible = False
                         break
                     lp_setup(A_lp, lb_lp, ub_lp, lb_s, ub_s, T, x, lb, ub, basis, nonbasic)
-                    first = True
+                    first = np.int64(1)
                     continue
-                first = False
+                first = np.int64(0)
                 stats[1] += 1
                 y = multipliers(T, basis, obj, nl)
                 obj[o] = 0.0
