@@ -413,7 +413,7 @@ def _build_engine_variants() -> None:
             terms = " + ".join(["y", *(_FAMILY_TERMS[n] for n in chosen)])
             model = parse_model(f"Variables x in [-1, 1], y in [-1, 1], z in [-9, 9];\n"
                                 f"Constraints z = {terms};")
-            propagate(model)
+            propagate(model, mode="hc4")
             CtcFwdBwd(model, ["x", "y", "z"])(Interval([-1.0, -1.0, -9.0], [1.0, 1.0, 9.0]))
 
 
