@@ -393,12 +393,13 @@ _FAMILY_TERMS = {"piecewise": "abs(x)", "pown": "x^3", "explog": "exp(y)", "trig
 
 
 def _build_engine_variants() -> None:
-    """Compile the hull-consistency kernels for every combination of operator families.
+    """Compile the kernels of ``propagate``'s default mode (hull consistency, shaving, the
+    centered windows) and ``CtcFwdBwd`` for every combination of operator families.
 
-    ``propagate`` and ``CtcFwdBwd`` pass each family that a tape does not use as ``None``, so
-    that Numba prunes its branches: one specialisation per combination (16). The commands use
-    a few of them; with all of them in the archive a user's own model compiles nothing in
-    hull-consistency mode, whatever operators it has (the other modes compile on first use).
+    They pass each family that a tape does not use as ``None``, so that Numba prunes its
+    branches: one specialisation per combination (16). The commands use a few of them; with
+    all of them in the archive a user's own model compiles nothing in the default mode or in
+    ``"hc4"``, whatever operators it has (the other modes compile on first use).
     """
     from itertools import combinations
 
@@ -413,7 +414,7 @@ def _build_engine_variants() -> None:
             terms = " + ".join(["y", *(_FAMILY_TERMS[n] for n in chosen)])
             model = parse_model(f"Variables x in [-1, 1], y in [-1, 1], z in [-9, 9];\n"
                                 f"Constraints z = {terms};")
-            propagate(model, mode="hc4")
+            propagate(model)  # the default mode: hull consistency, shaving, centered
             CtcFwdBwd(model, ["x", "y", "z"])(Interval([-1.0, -1.0, -9.0], [1.0, 1.0, 9.0]))
 
 
