@@ -298,7 +298,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--mode", choices=PROPAGATION_MODES, default="3b+centered",
                    help="shaving then the centered form of windows of constraints "
                         "(3b+centered, default: the tightest), hull consistency alone (hc4: "
-                        "the fastest, 25-800 times cheaper), then box consistency (bc), 3B "
+                        "the fastest, 25-900 times cheaper), then box consistency (bc), 3B "
                         "shaving (3b), both (bc+3b), LP contraction (lp, needs the lp extra) "
                         "or the centered form alone (centered); see boundest.csp.propagate "
                         "and docs/derivatives.md")

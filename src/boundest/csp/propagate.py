@@ -38,7 +38,7 @@ MODES = ("hc4", "bc", "3b", "bc+3b", "lp", "centered", "3b+centered")
 
 #: The mode ``propagate`` runs when none is given: chosen by measurement (benchmarks/README.md,
 #: "Which mode by default"), the only mode within 1.5x of the best widths on every problem
-#: measured, at 25-800 times the cost of ``"hc4"``, which stays one option away.
+#: measured, at 25-900 times the cost of ``"hc4"``, which stays one option away.
 DEFAULT_MODE = "3b+centered"
 
 
@@ -327,7 +327,7 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
     """Contract all domains of a CSP to a fixed point.
 
     The default mode is ``"3b+centered"`` (shaving, then the centered form): the tightest on
-    every model measured, at 25-800 times the cost of hull consistency alone (the record:
+    every model measured, at 25-900 times the cost of hull consistency alone (the record:
     ``benchmarks/results/modes.json``). For a large model or a quick look, ``mode="hc4"``
     costs one pass to the fixed point.
 
