@@ -8,12 +8,13 @@ For constraints ``f(x) in Y`` on a box ``X`` with centre ``c``, every solution `
 linear system ``J d in (Y & f(X)) - f(c)``, which
 :func:`~boundest.ctc.linear_forms.contract_rows` projects outward. Without preconditioning each
 constraint is taken on its own, with the first-order correlation of its variables kept. With
-Gauss-Jordan preconditioning (``P = mid(J)`` reduced, rows ``P J d in P (Y - f(c))``, swept
-forward, backward and forward, then the plain rows: the centered step of Codac 2's
-``CtcInverse`` also preconditions) the rows are nearly decoupled and the contraction is
-asymptotically minimal for narrow boxes (Jaulin 2023, arXiv 2307.10502): the result tends to
-the hull of the solution set, where hull consistency stays at the hull of each constraint's
-projection.
+preconditioning (the banded Gauss-Jordan ``R`` of ``mid(J)``, rows ``R J d in R z`` swept last
+to first and first to last, or an interval Gaussian elimination when there are more constraints
+than unknowns, then the plain rows: the sweeps of Codac 2's ``CtcInverse``, see
+:func:`_centered_step`) the rows are nearly decoupled and the contraction is asymptotically
+minimal for narrow boxes (Jaulin 2023, arXiv 2307.10502): the result tends to the hull of the
+solution set, where hull consistency stays at the hull of each constraint's projection. With
+``hc4=True`` one backward sweep of HC4 over the forward images follows, as in ``CtcInverse``.
 
 For a square system ``f(x) = t`` the preconditioned rows are the Hansen-Sengupta (Gauss-Seidel)
 step of interval Newton, and the Krawczyk operator
@@ -302,14 +303,19 @@ class CtcCentered(_Linearised):
     system : Model, list of Constraint or FunctionTape
         The constraints (see :func:`boundest.expr.function_tape.constraint_functions`).
     precondition : bool or {"gauss-jordan", "lp"}
-        After each constraint's linearisation on its own (all of it when False), also contract
-        with the rows of ``P J``: with True or
-        ``"gauss-jordan"``, ``P`` from Gauss-Jordan elimination on ``mid(J)`` with columns
-        scaled by the domains' widths (asymptotically minimal for narrow boxes, Jaulin 2023;
-        ``O(m^2 (m + n))`` per box); with ``"lp"``, for each variable and each of its bounds
-        the aggregation of the rows that a linear programme over the linearisation finds best
+        False: each constraint's linearisation on its own. True or ``"gauss-jordan"``: first
+        the preconditioned rows of :func:`_centered_step` (the banded Gauss-Jordan ``R`` of
+        ``mid(J)``, or interval elimination when ``m > n``; asymptotically minimal for narrow
+        boxes, Jaulin 2023; ``O(m^2 (m + n))`` per box), then the plain rows. ``"lp"``: the
+        plain rows, then for each variable and each of its bounds the aggregation of the rows
+        that a linear programme over the linearisation finds best
         (:mod:`boundest.ctc.windows`: the hull of the linearised set up to the Jacobian's
         width, two small dense simplexes per variable and box).
+    hc4 : bool
+        Then one backward sweep of forward-backward propagation (HC4-revise, node by node in
+        reverse) from the forward images over the box as given, on the variables as the
+        centered step left them: Codac 2's ``CtcInverse(f, y)``, in the same kernel (not
+        with ``"lp"``).
 
     Examples
     --------
