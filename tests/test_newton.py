@@ -167,10 +167,10 @@ def check_centered_keeps_solution(constraints, targets, names, xs, boxes) -> Non
     model = Model().add(*constraints)
     exprs = [c.lhs for c in constraints]
     tape = function_tape(exprs, names, targets)
-    for pre in (True, False):
-        from_model = CtcCentered(model, precondition=pre)
+    for pre, h in ((True, False), (False, False), (True, True)):
+        from_model = CtcCentered(model, precondition=pre, hc4=h)
         assert from_model.tape.names == names
-        ctcs = [from_model, CtcCentered(tape, precondition=pre)]
+        ctcs = [from_model, CtcCentered(tape, precondition=pre, hc4=h)]
         hc4 = CtcFwdBwd(model, names)
         ctcs += [ctcs[0] & hc4, hc4 & ctcs[1], Fixpoint(ctcs[0] & hc4, ratio=0.01, max_iter=30)]
         for ctc in ctcs:
@@ -181,7 +181,7 @@ def check_centered_keeps_solution(constraints, targets, names, xs, boxes) -> Non
         tg = Interval([t[0] for t in targets], [t[1] for t in targets])
         grow = np.linspace(0.0, 1.0, k)[:, None]
         per_box = Interval(tg.lo - grow, tg.hi + grow)
-        out = CtcCentered(tape, precondition=pre).contract(boxes, targets=per_box)
+        out = CtcCentered(tape, precondition=pre, hc4=h).contract(boxes, targets=per_box)
         for i in range(k):
             assert _float_in_box(xs, out[i]), ("per-box targets", boxes[i], out[i], xs)
 
@@ -247,7 +247,8 @@ def test_centered_contractors_on_empty_and_unbounded_boxes():
     model = Model().add(x * y == 2.0, x + y == 3.0)  # (1, 2) and (2, 1)
     boxes = Interval._new(np.array([[np.nan, 0.0], [-INF, -INF], [0.0, 1.5], [1.5, 0.0]]),
                           np.array([[np.nan, 1.0], [INF, INF], [INF, INF], [INF, 1.5]]))
-    for ctc in (CtcCentered(model), CtcCentered(model, precondition=False), CtcNewton(model)):
+    for ctc in (CtcCentered(model), CtcCentered(model, precondition=False),
+                CtcCentered(model, hc4=True), CtcNewton(model)):
         out = ctc(boxes)
         assert out[0].is_empty().all()
         assert _float_in_box((1.0, 2.0), out[1]) and _float_in_box((2.0, 1.0), out[1])

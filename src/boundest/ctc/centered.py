@@ -8,12 +8,13 @@ For constraints ``f(x) in Y`` on a box ``X`` with centre ``c``, every solution `
 linear system ``J d in (Y & f(X)) - f(c)``, which
 :func:`~boundest.ctc.linear_forms.contract_rows` projects outward. Without preconditioning each
 constraint is taken on its own, with the first-order correlation of its variables kept. With
-Gauss-Jordan preconditioning (``P = mid(J)`` reduced, rows ``P J d in P (Y - f(c))``, swept
-forward, backward and forward, then the plain rows: the centered step of Codac 2's
-``CtcInverse`` also preconditions) the rows are nearly decoupled and the contraction is
-asymptotically minimal for narrow boxes (Jaulin 2023, arXiv 2307.10502): the result tends to
-the hull of the solution set, where hull consistency stays at the hull of each constraint's
-projection.
+preconditioning (the banded Gauss-Jordan ``R`` of ``mid(J)``, rows ``R J d in R z`` swept last
+to first and first to last, or an interval Gaussian elimination when there are more constraints
+than unknowns, then the plain rows: the sweeps of Codac 2's ``CtcInverse``, see
+:func:`_centered_step`) the rows are nearly decoupled and the contraction is asymptotically
+minimal for narrow boxes (Jaulin 2023, arXiv 2307.10502): the result tends to the hull of the
+solution set, where hull consistency stays at the hull of each constraint's projection. With
+``hc4=True`` one backward sweep of HC4 over the forward images follows, as in ``CtcInverse``.
 
 For a square system ``f(x) = t`` the preconditioned rows are the Hansen-Sengupta (Gauss-Seidel)
 step of interval Newton, and the Krawczyk operator
@@ -37,8 +38,16 @@ from ..expr.model import Model
 from ..interval import Interval
 from ..interval.rounding import add_dn, add_up, mul_up, sub_dn, sub_up
 from .base import Contractor, _empty_rows
-from .derivatives import evaluate, jacobian_sparse, midpoint
-from .linear_forms import _term, contract_rows, point_times, preconditioner
+from .derivatives import evaluate, forward_jacobian, forward_pass, jacobian_sparse, midpoint
+from .linear_forms import (
+    _term,
+    band_preconditioner,
+    contract_rows,
+    interval_elimination,
+    point_times,
+    preconditioner,
+)
+from .revise import family_flags, revise_nodes
 from .windows import WINDOW_STATS, batch_kernel
 
 __all__ = ["CtcCentered", "CtcNewton"]
@@ -57,95 +66,213 @@ def _as_tape(system: FunctionTape | Model) -> FunctionTape:
 
 
 @_njit
-def _dense(entries_lo, entries_hi, row_ptr, cols, n):
-    """The dense ``(m, n)`` Jacobian of one box from its sparse entries."""
-    m = row_ptr.size - 1
-    jl = np.zeros((m, n))
-    jh = np.zeros((m, n))
-    for k in range(m):
+def _dense(entries_lo, entries_hi, row_ptr, cols, jl, jh):
+    """The dense ``(m, n)`` Jacobian ``jl, jh`` of one box from its sparse entries."""
+    jl[:, :] = 0.0
+    jh[:, :] = 0.0
+    for k in range(row_ptr.size - 1):
         for q in range(row_ptr[k], row_ptr[k + 1]):
             jl[k, cols[q]] = entries_lo[q]
             jh[k, cols[q]] = entries_hi[q]
-    return jl, jh
 
 
 @_njit
-def _midpoints(jl, jh):
-    """Finite midpoints of an interval matrix (0 where a bound is infinite)."""
-    a = np.empty(jl.shape)
+def _midpoints(jl, jh, a):
+    """Finite midpoints ``a`` of an interval matrix (0 where a bound is infinite)."""
     for i in range(jl.shape[0]):
         for j in range(jl.shape[1]):
             lo, hi = jl[i, j], jh[i, j]
             a[i, j] = 0.5 * lo + 0.5 * hi if (math.isfinite(lo) and math.isfinite(hi)) else 0.0
-    return a
 
 
 @_njit
-def _rhs(tl, th, fl, fh):
-    """``Y - f(c)`` rounded outward (entire where it is undefined)."""
-    m = tl.size
-    zl = np.empty(m)
-    zh = np.empty(m)
-    for k in range(m):
+def _rhs(tl, th, fl, fh, zl, zh):
+    """``zl, zh = Y - f(c)`` rounded outward (entire where it is undefined)."""
+    for k in range(tl.size):
         lo, hi = sub_dn(tl[k], fh[k]), sub_up(th[k], fl[k])
         zl[k] = lo if lo == lo else -INF
         zh[k] = hi if hi == hi else INF
-    return zl, zh
 
 
 @_njit
-def _centered_kernel(el, eh, row_ptr, cols, fcl, fch, vl, vh, tl, th, xl, xh, c, precondition):
-    """Contract each box ``(xl[b], xh[b])`` in place; an empty box gets NaN bounds. The
-    targets ``tl, th`` are per box, shape (n_boxes, m)."""
+def _centre(lo, hi):
+    """The point of ``[lo, hi]`` that :func:`~boundest.ctc.derivatives.midpoint` takes."""
+    if math.isfinite(lo) and math.isfinite(hi):
+        c = 0.5 * lo + 0.5 * hi
+    elif math.isfinite(lo):
+        c = lo
+    elif math.isfinite(hi):
+        c = hi
+    else:
+        c = 0.0
+    return min(max(c, lo), hi)
+
+
+@_njit
+def _centered_step(jl, jh, zl, zh, dl, dh, precondition, ws_m, ws_mn, ws_mm, piv, cp, work):
+    """The linear part of one centered step: contract ``d`` (in place) with ``J d in z``
+    (``jl, jh`` (m, n) and ``zl, zh`` (m,) are overwritten). Returns False when there is no
+    solution.
+
+    Without ``precondition`` the rows of ``J`` once. With it, in this order (each sweep starts
+    from what the previous one narrowed, and every one is sound on its own):
+
+    1. when ``m <= n``, the rows of ``R J d in R z`` with the banded preconditioner ``R`` of
+       ``mid(J)`` (:func:`~boundest.ctc.linear_forms.band_preconditioner`), last to first,
+       then first to last -- and, when the first ``m`` columns of ``mid(J)`` are near singular
+       (reciprocal condition number below ``1e-5``), the rows of ``J`` last to first and
+       first to last; when ``m > n``, the rows of the interval Gaussian elimination of
+       ``J d in z`` (:func:`~boundest.ctc.linear_forms.interval_elimination`, full pivoting on
+       ``mid(J)``), the consistency rows (``0 in z_i``) first, then the pivot rows last to
+       first;
+    2. the rows of ``J``, first to last.
+
+    That is, sweep for sweep, what Codac 2's ``CtcInverse`` does after its forward evaluation
+    (its ``MulOp::bwd``: the rows of ``R J`` last to first and first to last, or an interval
+    LU solve when ``m > n``, then the rows of ``J``), with each row contraction at least as
+    tight (relational division in every product, the variables contracted earlier in the row
+    reused), so the result lies inside Codac's up to rounding.
+    """
+    m, n = jl.shape
+    if not precondition or m == 0:
+        return contract_rows(jl, jh, zl, zh, dl, dh, False, work)
+    mid = ws_mn[0]
+    _midpoints(jl, jh, mid)
+    gl, gh = ws_mn[1], ws_mn[2]
+    rl, rh = ws_m[0], ws_m[1]
+    if m <= n:
+        R, B = ws_mm[0], ws_mm[1]
+        rc = band_preconditioner(mid, R, B, piv)
+        if rc > 0.0:
+            point_times(R, jl, jh, gl, gh)
+            point_times(R, zl.reshape(-1, 1), zh.reshape(-1, 1), rl.reshape(-1, 1),
+                        rh.reshape(-1, 1))
+            if not (contract_rows(gl, gh, rl, rh, dl, dh, True, work)
+                    and contract_rows(gl, gh, rl, rh, dl, dh, False, work)):
+                return False
+        if rc < 1e-5 and not (contract_rows(jl, jh, zl, zh, dl, dh, True, work)
+                              and contract_rows(jl, jh, zl, zh, dl, dh, False, work)):
+            return False
+    else:
+        el, eh = ws_mn[3], ws_mn[4]
+        el[:, :] = jl
+        eh[:, :] = jh
+        ezl, ezh = ws_m[2], ws_m[3]
+        ezl[:] = zl
+        ezh[:] = zh
+        steps = interval_elimination(el, eh, ezl, ezh, mid, piv, cp)
+        # the rows in pivot order (the consistency rows last), swept last to first
+        for k in range(m):
+            q = piv[k]
+            gl[k, :] = el[q, :]
+            gh[k, :] = eh[q, :]
+            rl[k], rh[k] = ezl[q], ezh[q]
+        if steps > 0 and not contract_rows(gl, gh, rl, rh, dl, dh, True, work):
+            return False
+    return contract_rows(jl, jh, zl, zh, dl, dh, False, work)
+
+
+@_njit
+def _centered_kernel(op, out, a, b, param, node_ptr, out_slot, row_ptr, cols, slot_lo, slot_hi,
+                     tl, th, xl, xh, precondition, hc4, piecewise, pown, explog, trig):
+    """Contract each box ``(xl[b], xh[b])`` in place (an empty box gets NaN bounds): the
+    forward images over the box, its Jacobian (reverse mode), the outputs at its centre, the
+    centered step (:func:`_centered_step`) on ``(Y & f(X)) - f(c)`` and, with ``hc4``, one
+    forward-backward pass over the tape on the contracted box. The targets ``tl, th`` are per
+    box, shape (n_boxes, m). One call per batch; the workspaces are allocated once."""
     n = xl.shape[1]
+    m = out_slot.size
+    ns = slot_lo.size
+    nnz = cols.size
+    sl, sh = np.empty(ns), np.empty(ns)
+    cl, ch = np.empty(ns), np.empty(ns)
+    width = 1
+    for k in range(m):
+        width = max(width, row_ptr[k + 1] - row_ptr[k])
+    gdl, gdh = np.zeros((ns, width)), np.zeros((ns, width))
+    buf = np.empty(4)
+    el, eh = np.empty(nnz), np.empty(nnz)
+    jl, jh = np.empty((m, n)), np.empty((m, n))
+    yl, yh = np.empty(m), np.empty(m)
+    zl, zh = np.empty(m), np.empty(m)
+    dl, dh = np.empty(n), np.empty(n)
+    c = np.empty(n)
+    ws_m = np.empty((4, m))
+    ws_mn = np.empty((5, m, n))  # mid(J), the preconditioned rows, the eliminated system
+    ws_mm = np.empty((2, m, m))
+    piv = np.empty(max(m, 1), dtype=np.int64)
+    cp = np.empty(n, dtype=np.int64)
+    work = np.empty((6, n + 1))
     for bx in range(xl.shape[0]):
-        if not (np.all(xl[bx] <= xh[bx])):
+        if not np.all(xl[bx] <= xh[bx]):
             continue
+        sl[:] = slot_lo
+        sh[:] = slot_hi
+        sl[:n] = xl[bx]
+        sh[:n] = xh[bx]
+        forward_pass(op, out, a, b, param, sl, sh, buf, piecewise, pown, explog, trig)
         empty = False
-        for k in range(tl.shape[1]):  # the natural form already refutes the box
-            if vl[bx, k] > th[bx, k] or vh[bx, k] < tl[bx, k]:
+        for k in range(m):  # the natural form already refutes the box
+            vl, vh = sl[out_slot[k]], sh[out_slot[k]]
+            if vl > th[bx, k] or vh < tl[bx, k]:
                 empty = True
-        if not empty:
-            if np.any(np.isnan(fcl[bx])):
-                continue  # the centre is outside some primitive's domain: no linearisation
-            jl, jh = _dense(el[bx], eh[bx], row_ptr, cols, n)
             # f(x) lies in Y and in the natural form f(X): Y & f(X) - f(c) (as Codac 2 does)
-            m = tl.shape[1]
-            yl = np.empty(m)
-            yh = np.empty(m)
-            for k in range(m):
-                yl[k] = max(tl[bx, k], vl[bx, k]) if vl[bx, k] == vl[bx, k] else tl[bx, k]
-                yh[k] = min(th[bx, k], vh[bx, k]) if vh[bx, k] == vh[bx, k] else th[bx, k]
-            zl, zh = _rhs(yl, yh, fcl[bx], fch[bx])
-            dl = np.empty(n)
-            dh = np.empty(n)
+            yl[k] = max(tl[bx, k], vl) if vl == vl else tl[bx, k]
+            yh[k] = min(th[bx, k], vh) if vh == vh else th[bx, k]
+        if not empty:
+            cl[:] = slot_lo
+            ch[:] = slot_hi
             for j in range(n):
-                dl[j] = sub_dn(xl[bx, j], c[bx, j])
-                dh[j] = sub_up(xh[bx, j], c[bx, j])
-            empty = not contract_rows(jl, jh, zl, zh, dl, dh)
-            if not empty and precondition:
-                A = _midpoints(jl, jh)
+                c[j] = _centre(xl[bx, j], xh[bx, j])
+                cl[j] = ch[j] = c[j]
+            forward_pass(op, out, a, b, param, cl, ch, buf, piecewise, pown, explog, trig)
+            centre_ok = True
+            for k in range(m):
+                if cl[out_slot[k]] != cl[out_slot[k]]:
+                    centre_ok = False  # c outside some primitive's domain: no linearisation
+            if centre_ok:
+                forward_jacobian(op, out, a, b, param, node_ptr, out_slot, row_ptr, cols, sl,
+                                 sh, gdl, gdh, buf, el, eh)
+                _dense(el, eh, row_ptr, cols, jl, jh)
+                for k in range(m):
+                    fl, fh = cl[out_slot[k]], ch[out_slot[k]]
+                    lo, hi = sub_dn(yl[k], fh), sub_up(yh[k], fl)
+                    zl[k] = lo if lo == lo else -INF
+                    zh[k] = hi if hi == hi else INF
                 for j in range(n):
-                    w = dh[j] - dl[j]
-                    A[:, j] *= w if math.isfinite(w) else 1e300
-                P, _ = preconditioner(A)
-                ml, mh = point_times(P, jl, jh)
-                rl, rh = point_times(P, zl.reshape(-1, 1), zh.reshape(-1, 1))
-                # the preconditioned rows forward, backward and forward again (each sweep
-                # starts from what the previous one narrowed), then the plain rows
-                bl, bh = ml[::-1].copy(), mh[::-1].copy()
-                brl, brh = rl[::-1, 0].copy(), rh[::-1, 0].copy()
-                empty = not (contract_rows(ml, mh, rl[:, 0], rh[:, 0], dl, dh)
-                             and contract_rows(bl, bh, brl, brh, dl, dh)
-                             and contract_rows(ml, mh, rl[:, 0], rh[:, 0], dl, dh)
-                             and contract_rows(jl, jh, zl, zh, dl, dh))
+                    dl[j] = sub_dn(xl[bx, j], c[j])
+                    dh[j] = sub_up(xh[bx, j], c[j])
+                if _centered_step(jl, jh, zl, zh, dl, dh, precondition, ws_m, ws_mn, ws_mm, piv,
+                                  cp, work):
+                    for j in range(n):
+                        xl[bx, j] = max(xl[bx, j], add_dn(c[j], dl[j]))
+                        xh[bx, j] = min(xh[bx, j], add_up(c[j], dh[j]))
+                        if not xl[bx, j] <= xh[bx, j]:
+                            empty = True
+                else:
+                    empty = True
+        if not empty and hc4:
+            # Codac's backward sweep, from the forward images over the box as given (still in
+            # the slots) and the variables as the centered step left them
+            for j in range(n):
+                sl[j], sh[j] = xl[bx, j], xh[bx, j]
+            for k in range(m):
+                o = out_slot[k]
+                sl[o], sh[o] = max(sl[o], tl[bx, k]), min(sh[o], th[bx, k])
+                if not sl[o] <= sh[o]:
+                    empty = True
+            if not empty and revise_nodes(op, out, a, b, param, sl, sh, buf, True, piecewise,
+                                          pown, explog, trig):
+                for j in range(n):
+                    xl[bx, j] = max(xl[bx, j], sl[j])
+                    xh[bx, j] = min(xh[bx, j], sh[j])
+                    if not xl[bx, j] <= xh[bx, j]:
+                        empty = True
+            else:
+                empty = True
         if empty:
             xl[bx, :] = np.nan
             xh[bx, :] = np.nan
-            continue
-        for j in range(n):
-            xl[bx, j] = max(xl[bx, j], add_dn(c[bx, j], dl[j]))
-            xh[bx, j] = min(xh[bx, j], add_up(c[bx, j], dh[j]))
 
 
 class _Linearised(Contractor):
@@ -176,14 +303,19 @@ class CtcCentered(_Linearised):
     system : Model, list of Constraint or FunctionTape
         The constraints (see :func:`boundest.expr.function_tape.constraint_functions`).
     precondition : bool or {"gauss-jordan", "lp"}
-        After each constraint's linearisation on its own (all of it when False), also contract
-        with the rows of ``P J``: with True or
-        ``"gauss-jordan"``, ``P`` from Gauss-Jordan elimination on ``mid(J)`` with columns
-        scaled by the domains' widths (asymptotically minimal for narrow boxes, Jaulin 2023;
-        ``O(m^2 (m + n))`` per box); with ``"lp"``, for each variable and each of its bounds
-        the aggregation of the rows that a linear programme over the linearisation finds best
+        False: each constraint's linearisation on its own. True or ``"gauss-jordan"``: first
+        the preconditioned rows of :func:`_centered_step` (the banded Gauss-Jordan ``R`` of
+        ``mid(J)``, or interval elimination when ``m > n``; asymptotically minimal for narrow
+        boxes, Jaulin 2023; ``O(m^2 (m + n))`` per box), then the plain rows. ``"lp"``: the
+        plain rows, then for each variable and each of its bounds the aggregation of the rows
+        that a linear programme over the linearisation finds best
         (:mod:`boundest.ctc.windows`: the hull of the linearised set up to the Jacobian's
         width, two small dense simplexes per variable and box).
+    hc4 : bool
+        Then one backward sweep of forward-backward propagation (HC4-revise, node by node in
+        reverse) from the forward images over the box as given, on the variables as the
+        centered step left them: Codac 2's ``CtcInverse(f, y)``, in the same kernel (not
+        with ``"lp"``).
 
     Examples
     --------
@@ -194,19 +326,23 @@ class CtcCentered(_Linearised):
     Interval([[0.5, 0.5], [0.5, 0.5]])
     """
 
-    def __init__(self, system: FunctionTape | Model, precondition: bool | str = True) -> None:
+    def __init__(self, system: FunctionTape | Model, precondition: bool | str = True,
+                 hc4: bool = False) -> None:
         super().__init__(system)
         if precondition not in (True, False, "gauss-jordan", "lp"):
             raise ValueError(f"precondition must be True, False, 'gauss-jordan' or 'lp', got "
                              f"{precondition!r}")
         self.precondition = precondition
+        self.hc4 = bool(hc4)
+        self._flags = family_flags(self.tape.op)
 
     def contract(self, x: Interval, targets: Interval | None = None) -> Interval:
         """Contract boxes ``(..., n)``; ``targets`` (broadcast to ``(..., m)``) replaces the
         tape's target sets, one per box (the same constraints with other data)."""
-        box, c, values, entries, _, fc = self._linearise(x)
-        lo, hi = box.lo.copy(), box.hi.copy()
         t = self.tape
+        box = x.reshape(-1, self.n)
+        lo = np.array(box.lo, dtype=np.float64, order="C")
+        hi = np.array(box.hi, dtype=np.float64, order="C")
         if targets is None:
             tl = np.broadcast_to(t.target_lo, (len(lo), t.n_outputs))
             th = np.broadcast_to(t.target_hi, (len(lo), t.n_outputs))
@@ -214,10 +350,15 @@ class CtcCentered(_Linearised):
             shape = (*x.shape[:-1], t.n_outputs)
             tl = np.broadcast_to(targets.lo, shape).reshape(len(lo), -1)
             th = np.broadcast_to(targets.hi, shape).reshape(len(lo), -1)
-        tl, th = np.ascontiguousarray(tl), np.ascontiguousarray(th)
-        _centered_kernel(entries.lo, entries.hi, t.row_ptr, t.cols, fc.lo, fc.hi, values.lo,
-                         values.hi, tl, th, lo, hi, c, self.precondition in (True, "gauss-jordan"))
-        if self.precondition == "lp":
+        tl, th = np.ascontiguousarray(tl, dtype=np.float64), np.ascontiguousarray(th, np.float64)
+        lp = self.precondition == "lp"
+        if lp:  # the linear programmes linearise on the box as given
+            _, c, _, entries, _, fc = self._linearise(x)
+        _centered_kernel(t.op, t.out, t.a, t.b, t.param, t.node_ptr, t.out_slot, t.row_ptr,
+                         t.cols, t.lo, t.hi, tl, th, lo, hi,
+                         self.precondition in (True, "gauss-jordan"), self.hc4 and not lp,
+                         *self._flags)
+        if lp:
             stats = np.zeros(len(WINDOW_STATS), dtype=np.int64)
             batch_kernel(entries.lo, entries.hi, t.row_ptr, t.cols, fc.lo, fc.hi, tl, th, lo,
                          hi, c, 20 * (t.n_outputs + self.n) + 200, stats)
@@ -228,27 +369,37 @@ class CtcCentered(_Linearised):
 def _newton_kernel(el, eh, row_ptr, cols, fcl, fch, ok, tl, th, xl, xh, c, proved):
     """Hansen-Sengupta contraction and the Krawczyk test of each box, in place."""
     n = xl.shape[1]
+    jl, jh = np.empty((n, n)), np.empty((n, n))
+    ml, mh = np.empty((n, n)), np.empty((n, n))
+    mid = np.empty((n, n))
+    W = np.empty((n, 2 * n))
+    pivot = np.empty(n, dtype=np.int64)
+    used = np.empty(n, dtype=np.bool_)
+    P = np.empty((n, n))
+    zl, zh = np.empty(n), np.empty(n)
+    rl, rh = np.empty((n, 1)), np.empty((n, 1))
+    dl, dh, rad = np.empty(n), np.empty(n), np.empty(n)
+    work = np.empty((6, n + 1))
     for bx in range(xl.shape[0]):
         proved[bx] = False
         if not np.all(xl[bx] <= xh[bx]) or np.any(np.isnan(fcl[bx])):
             continue
-        jl, jh = _dense(el[bx], eh[bx], row_ptr, cols, n)
-        P0, pivot = preconditioner(_midpoints(jl, jh))
-        P = np.zeros((n, n))
+        _dense(el[bx], eh[bx], row_ptr, cols, jl, jh)
+        _midpoints(jl, jh, mid)
+        preconditioner(mid, W, pivot, used)
         full = True
         for r in range(n):
             if pivot[r] < 0:
                 full = False
+        P[:, :] = 0.0
+        for r in range(n):
+            if full:
+                P[pivot[r]] = W[r, n:]  # P mid(J) ~ I, rows in the order of the variables
             else:
-                P[pivot[r]] = P0[r]  # P mid(J) ~ I, rows in the order of the variables
-        if not full:
-            P = P0
-        zl, zh = _rhs(tl, th, fcl[bx], fch[bx])
-        ml, mh = point_times(P, jl, jh)
-        rl, rh = point_times(P, zl.reshape(-1, 1), zh.reshape(-1, 1))
-        dl = np.empty(n)
-        dh = np.empty(n)
-        rad = np.empty(n)
+                P[r] = W[r, n:]
+        _rhs(tl, th, fcl[bx], fch[bx], zl, zh)
+        point_times(P, jl, jh, ml, mh)
+        point_times(P, zl.reshape(-1, 1), zh.reshape(-1, 1), rl, rh)
         for j in range(n):
             dl[j] = sub_dn(xl[bx, j], c[bx, j])
             dh[j] = sub_up(xh[bx, j], c[bx, j])
@@ -270,7 +421,7 @@ def _newton_kernel(el, eh, row_ptr, cols, fcl, fch, ok, tl, th, xl, xh, c, prove
                     inside = False
                     break
             proved[bx] = inside
-        if not contract_rows(ml, mh, rl[:, 0], rh[:, 0], dl, dh):
+        if not contract_rows(ml, mh, rl[:, 0], rh[:, 0], dl, dh, False, work):
             proved[bx] = False
             xl[bx, :] = np.nan
             xh[bx, :] = np.nan

@@ -70,7 +70,7 @@ from .revise import (
     revise,
 )
 
-__all__ = ["centered", "evaluate", "jacobian", "jacobian_sparse"]
+__all__ = ["centered", "evaluate", "forward_jacobian", "jacobian", "jacobian_sparse"]
 
 INF = math.inf
 _add_lo, _add_hi, _sub_lo, _sub_hi = (ar._add_lo.scalar, ar._add_hi.scalar, ar._sub_lo.scalar,
@@ -298,6 +298,96 @@ def _accumulate(adl, adh, s, gl, gh, sl, sh):
 
 
 @_njit
+def box_jacobian(op, out, a, b, param, node_ptr, out_slot, row_ptr, cols, sl, sh, adl, adh,
+                 buf, jl, jh):
+    """Sparse Jacobian ``jl, jh`` (nnz,) of one box whose slots ``sl, sh`` hold the forward
+    images (:func:`forward_pass`): one reverse sweep per output over that output's nodes.
+    ``adl, adh`` (n_slots,) are zero on entry and on return."""
+    for k in range(out_slot.size):
+        adl[out_slot[k]] = 1.0
+        adh[out_slot[k]] = 1.0
+        for i in range(node_ptr[k + 1] - 1, node_ptr[k] - 1, -1):
+            o = out[i]
+            gl, gh = adl[o], adh[o]
+            if gl == 0.0 and gh == 0.0:
+                continue
+            ia, ib = a[i], b[i]
+            yl, yh = (sl[ib], sh[ib]) if ib >= 0 else (0.0, 0.0)
+            sxl, sxh, syl, syh = slopes(op[i], sl[o], sh[o], sl[ia], sh[ia], yl, yh, param[i],
+                                        buf)
+            _accumulate(adl, adh, ia, gl, gh, sxl, sxh)
+            if ib >= 0:
+                _accumulate(adl, adh, ib, gl, gh, syl, syh)
+        for j in range(row_ptr[k], row_ptr[k + 1]):
+            jl[j] = adl[cols[j]]
+            jh[j] = adh[cols[j]]
+        adl[out_slot[k]] = adh[out_slot[k]] = 0.0
+        for i in range(node_ptr[k], node_ptr[k + 1]):
+            adl[a[i]] = adh[a[i]] = 0.0
+            if b[i] >= 0:
+                adl[b[i]] = adh[b[i]] = 0.0
+
+
+@_njit
+def forward_jacobian(op, out, a, b, param, node_ptr, out_slot, row_ptr, cols, sl, sh, dl, dh,
+                     buf, jl, jh):
+    """Sparse Jacobian ``jl, jh`` (nnz,) of one box in forward mode (the slots ``sl, sh`` hold
+    the forward images, :func:`forward_pass`): for each output, the gradient of every node of
+    its block over the output's own variables, ``D_z = S_x D_x + S_y D_y`` with the local
+    slopes ``S`` of :func:`slopes` (sound by sub-distributivity: ``S (D d)`` lies in
+    ``(S D) d``), except a quotient, which takes ``(D_x y - x D_y) / y^2`` (the quotient
+    rule, as Codac 2 differentiates; entire when ``y`` contains 0). ``dl, dh``
+    (n_slots, max row length) are scratch whose constant rows must be zero (they stay so)."""
+    for k in range(out_slot.size):
+        c0 = row_ptr[k]
+        nk = row_ptr[k + 1] - c0
+        for q in range(nk):
+            j = cols[c0 + q]
+            for t in range(nk):
+                dl[j, t] = dh[j, t] = 0.0
+            dl[j, q] = dh[j, q] = 1.0
+        for i in range(node_ptr[k], node_ptr[k + 1]):
+            o, ia, ib = out[i], a[i], b[i]
+            xl, xh = sl[ia], sh[ia]
+            yl, yh = (sl[ib], sh[ib]) if ib >= 0 else (0.0, 0.0)
+            if op[i] == DIV:
+                if yl <= 0.0 <= yh or not yl <= yh:
+                    for t in range(nk):
+                        dl[o, t], dh[o, t] = -INF, INF
+                    continue
+                ql, qh = _sqr_lo(yl, yh), _sqr_hi(yl, yh)
+                for t in range(nk):
+                    ul, uh = _mul(dl[ia, t], dh[ia, t], yl, yh)
+                    vl, vh = _mul(xl, xh, dl[ib, t], dh[ib, t])
+                    wl, wh = _sub_lo(ul, uh, vl, vh), _sub_hi(ul, uh, vl, vh)
+                    rl, rh = _div(wl, wh, ql, qh)
+                    dl[o, t] = rl if rl == rl else -INF
+                    dh[o, t] = rh if rh == rh else INF
+                continue
+            sxl, sxh, syl, syh = slopes(op[i], sl[o], sh[o], xl, xh, yl, yh, param[i], buf)
+            for t in range(nk):
+                ul, uh = _term0(sxl, sxh, dl[ia, t], dh[ia, t])
+                if ib >= 0:
+                    vl, vh = _term0(syl, syh, dl[ib, t], dh[ib, t])
+                    ul, uh = _add_lo(ul, uh, vl, vh), _add_hi(ul, uh, vl, vh)
+                dl[o, t] = ul if ul == ul else -INF
+                dh[o, t] = uh if uh == uh else INF
+        s = out_slot[k]
+        for q in range(nk):
+            jl[c0 + q] = dl[s, q]
+            jh[c0 + q] = dh[s, q]
+
+
+@nb.njit(cache=True, inline="always", error_model="numpy")
+def _term0(sl, sh, gl, gh):
+    """``S D`` for a chain-rule term: exactly 0 when either factor is [0, 0] (a constant's
+    zero gradient times an unbounded slope contributes nothing)."""
+    if (sl == 0.0 and sh == 0.0) or (gl == 0.0 and gh == 0.0):
+        return 0.0, 0.0
+    return _mul(sl, sh, gl, gh)
+
+
+@_njit
 def jacobian_kernel(op, out, a, b, param, node_ptr, out_slot, row_ptr, cols, lo, hi, jl, jh,
                     ok, piecewise, pown, explog, trig):
     """Forward images and sparse Jacobians of a function tape over a batch of boxes.
@@ -311,7 +401,6 @@ def jacobian_kernel(op, out, a, b, param, node_ptr, out_slot, row_ptr, cols, lo,
     adl = np.zeros(n_slots)
     adh = np.zeros(n_slots)
     buf = np.empty(4)
-    m = out_slot.size
     for bx in range(lo.shape[0]):
         sl, sh = lo[bx], hi[bx]
         forward_pass(op, out, a, b, param, sl, sh, buf, piecewise, pown, explog, trig)
@@ -323,29 +412,8 @@ def jacobian_kernel(op, out, a, b, param, node_ptr, out_slot, row_ptr, cols, lo,
                 good = False
                 break
         ok[bx] = good
-        for k in range(m):
-            adl[out_slot[k]] = 1.0
-            adh[out_slot[k]] = 1.0
-            for i in range(node_ptr[k + 1] - 1, node_ptr[k] - 1, -1):
-                o = out[i]
-                gl, gh = adl[o], adh[o]
-                if gl == 0.0 and gh == 0.0:
-                    continue
-                ia, ib = a[i], b[i]
-                yl, yh = (sl[ib], sh[ib]) if ib >= 0 else (0.0, 0.0)
-                sxl, sxh, syl, syh = slopes(op[i], sl[o], sh[o], sl[ia], sh[ia], yl, yh,
-                                            param[i], buf)
-                _accumulate(adl, adh, ia, gl, gh, sxl, sxh)
-                if ib >= 0:
-                    _accumulate(adl, adh, ib, gl, gh, syl, syh)
-            for j in range(row_ptr[k], row_ptr[k + 1]):
-                jl[bx, j] = adl[cols[j]]
-                jh[bx, j] = adh[cols[j]]
-            adl[out_slot[k]] = adh[out_slot[k]] = 0.0
-            for i in range(node_ptr[k], node_ptr[k + 1]):
-                adl[a[i]] = adh[a[i]] = 0.0
-                if b[i] >= 0:
-                    adl[b[i]] = adh[b[i]] = 0.0
+        box_jacobian(op, out, a, b, param, node_ptr, out_slot, row_ptr, cols, sl, sh, adl, adh,
+                     buf, jl[bx], jh[bx])
 
 
 @_njit

@@ -20,40 +20,43 @@ from __future__ import annotations
 import math
 
 import numba as nb
-import numpy as np
 
+from ..interval.algebraic import _mul_rev_all
 from ..interval.rounding import add_dn, add_up, mul_dn, mul_up
 from .revise import _div_hi, _div_lo, _sub_hi, _sub_lo
 
-__all__ = ["contract_rows", "point_times", "preconditioner"]
+__all__ = ["band_preconditioner", "contract_rows", "interval_elimination", "point_times",
+           "preconditioner"]
 
 _njit = nb.njit(cache=True, error_model="numpy")
 INF = math.inf
 
 
 @_njit
-def preconditioner(A):
-    """A real ``P`` (m, m) with ``P A`` reduced by Gauss-Jordan with full pivoting.
+def preconditioner(A, W, pivot, used):
+    """Gauss-Jordan elimination with full pivoting on ``A`` (m, n), in the workspace ``W``
+    (m, n + m): afterwards ``P = W[:, n:]`` is a real (m, m) matrix with ``P A`` reduced.
 
     Pivots smaller than ``1e-300`` times the largest entry end the elimination (the rank
     deficient rows of ``P`` are then what elimination left, which is still a valid, if weaker,
-    preconditioner). Returns ``(P, pivot)``: ``pivot[i]`` is row ``i``'s pivot column, -1 if
-    none.
+    preconditioner). ``pivot[i]`` (m,) receives row ``i``'s pivot column, -1 if none; ``used``
+    (n,) is scratch.
     """
     m, n = A.shape
-    W = np.empty((m, n + m))
-    W[:, :n] = A
-    W[:, n:] = 0.0
     for i in range(m):
-        W[i, n + i] = 1.0
-    pivot = np.full(m, -1, dtype=np.int64)
-    used = np.zeros(n, dtype=np.bool_)
+        pivot[i] = -1
+        for j in range(n):
+            W[i, j] = A[i, j]
+        for j in range(m):
+            W[i, n + j] = 1.0 if i == j else 0.0
+    for j in range(n):
+        used[j] = False
     scale = 0.0
     for i in range(m):
         for j in range(n):
             scale = max(scale, abs(A[i, j]))
     if not scale > 0.0 or not math.isfinite(scale):
-        return W[:, n:].copy(), pivot
+        return
     for r in range(m):
         best, bi, bj = 0.0, -1, -1
         for i in range(r, m):
@@ -75,7 +78,165 @@ def preconditioner(A):
                     W[i, j] -= f * W[r, j]
         used[bj] = True
         pivot[r] = bj
-    return W[:, n:].copy(), pivot
+
+
+@_njit
+def band_preconditioner(A, R, B, perm):
+    """The banded Gauss-Jordan preconditioner of Jaulin's centered-form paper (the one Codac
+    2's ``CtcInverse`` applies when ``m <= n``) for a real ``A`` (m, n), ``m <= n``.
+
+    ``B`` (m, m) and ``perm`` (m,) are scratch. An LU factorisation with partial (row)
+    pivoting of the first ``m`` columns gives ``R = L^-1 Perm`` with ``R A`` upper triangular
+    in those columns; then, for ``i = m - 1 .. 1``, row ``i`` eliminates column ``i + n - m``
+    from the rows above it. Row ``i`` of ``R A`` is then zero outside columns
+    ``i .. i + n - m``: every variable is in few rows, and the rows are nearly decoupled (for
+    a square ``A``, ``R A`` is diagonal: Gauss-Jordan). Any real ``R`` is sound. Writes ``R``
+    (m, m) and returns the reciprocal condition number (1-norm) of the first ``m`` columns,
+    0 when they are singular (then ``R`` is the identity).
+    """
+    m, n = A.shape
+    p = n - m
+    norm = 0.0
+    for j in range(m):
+        s = 0.0
+        for i in range(m):
+            B[i, j] = A[i, j]
+            s += abs(A[i, j])
+        norm = max(norm, s)
+    for i in range(m):
+        perm[i] = i
+    singular = not (norm > 0.0 and math.isfinite(norm))
+    for k in range(m):
+        if singular:
+            break
+        bi, best = k, abs(B[k, k])
+        for i in range(k + 1, m):
+            if abs(B[i, k]) > best:
+                bi, best = i, abs(B[i, k])
+        if not best > 0.0:
+            singular = True
+            break
+        if bi != k:
+            for j in range(m):
+                B[k, j], B[bi, j] = B[bi, j], B[k, j]
+            perm[k], perm[bi] = perm[bi], perm[k]
+        for i in range(k + 1, m):
+            f = B[i, k] / B[k, k]
+            B[i, k] = f
+            for j in range(k + 1, m):
+                B[i, j] -= f * B[k, j]
+    for i in range(m):
+        for j in range(m):
+            R[i, j] = 0.0
+        R[i, i] = 1.0
+    if singular:
+        return 0.0
+    # the 1-norm of the inverse, column by column: B^-1 e_j = U^-1 L^-1 Perm e_j
+    inv_norm = 0.0
+    for j in range(m):
+        s = 0.0
+        for i in range(m):  # R is scratch for one column here: solve L y = Perm e_j, U x = y
+            v = 1.0 if perm[i] == j else 0.0
+            for k in range(i):
+                v -= B[i, k] * R[k, 0]
+            R[i, 0] = v
+        for i in range(m - 1, -1, -1):
+            v = R[i, 0]
+            for k in range(i + 1, m):
+                v -= B[i, k] * R[k, 0]
+            R[i, 0] = v / B[i, i]
+            s += abs(R[i, 0])
+        inv_norm = max(inv_norm, s)
+    # R = L^-1 Perm
+    for i in range(m):
+        for j in range(m):
+            R[i, j] = 1.0 if perm[i] == j else 0.0
+        for k in range(i):
+            f = B[i, k]
+            if f != 0.0:
+                for j in range(m):
+                    R[i, j] -= f * R[k, j]
+    # rising: row i clears column i + p in the rows above it
+    for i in range(m - 1, 0, -1):
+        col = i + p
+        piv = 0.0
+        for k in range(m):
+            piv += R[i, k] * A[k, col]
+        if piv == 0.0 or not math.isfinite(piv):
+            continue
+        for r in range(i):
+            u = 0.0
+            for k in range(m):
+                u += R[r, k] * A[k, col]
+            f = u / piv
+            if f != 0.0:
+                for k in range(m):
+                    R[r, k] -= f * R[i, k]
+    rc = 1.0 / (norm * inv_norm)
+    return rc if rc == rc else 0.0
+
+
+@_njit
+def interval_elimination(gl, gh, zl, zh, M, rp, cp):
+    """Interval Gaussian elimination of ``G d in z`` (``gl, gh`` (m, n), ``zl, zh`` (m,), in
+    place) with the pivots of full pivoting on ``M`` (m, n: a real matrix, ``mid(G)``,
+    overwritten).
+
+    Step ``k`` takes pivot row ``rp[k]`` and column ``cp[k]`` and, for every row ``i`` below,
+    the interval multiplier ``l = G[i, c] / G[r, c]`` (it holds ``S[i, c] / S[r, c]`` for
+    every real ``S`` in ``G``), so that ``row_i - l row_r`` has a zero in column ``c`` for that
+    ``S``: column ``c`` is set to 0 and the other entries and ``z_i`` get ``- l G[r, j]``,
+    ``- l z_r`` (rounded outward). Every row stays sound: for the ``S`` and ``s in z`` of a
+    solution, ``(S_i - l S_r) d = s_i - l s_r`` holds with the multiplier's true value. The
+    first ``min(m, n)`` rows in ``rp`` order are then upper triangular in the columns ``cp``;
+    the rows after them (when ``m > n``) have only zeros left: ``0 in z_i`` is their
+    consistency test. Elimination stops at a pivot interval containing 0. ``rp`` (m,) and
+    ``cp`` (n,) receive the pivot order; returns the number of steps done.
+    """
+    m, n = gl.shape
+    for i in range(m):
+        rp[i] = i
+    for j in range(n):
+        cp[j] = j
+    steps = 0
+    for k in range(min(m, n)):
+        best, bi, bj = 0.0, -1, -1
+        for i in range(k, m):
+            for j in range(k, n):
+                v = abs(M[rp[i], cp[j]])
+                if v > best:
+                    best, bi, bj = v, i, j
+        if bi < 0 or not math.isfinite(best):
+            break
+        rp[k], rp[bi] = rp[bi], rp[k]
+        cp[k], cp[bj] = cp[bj], cp[k]
+        r, c = rp[k], cp[k]
+        for i in range(k + 1, m):
+            f = M[rp[i], c] / M[r, c]
+            for j in range(k, n):
+                M[rp[i], cp[j]] -= f * M[r, cp[j]]
+        pl, ph = gl[r, c], gh[r, c]
+        if pl <= 0.0 <= ph or not (pl <= ph):
+            break
+        for i in range(k + 1, m):
+            q = rp[i]
+            if gl[q, c] == 0.0 and gh[q, c] == 0.0:
+                continue
+            ll = _nan_lo(_div_lo(gl[q, c], gh[q, c], pl, ph))
+            lh = _nan_hi(_div_hi(gl[q, c], gh[q, c], pl, ph))
+            gl[q, c] = gh[q, c] = 0.0
+            for t in range(k + 1, n):
+                j = cp[t]
+                if gl[r, j] == 0.0 and gh[r, j] == 0.0:
+                    continue
+                sl, sh = _term(ll, lh, gl[r, j], gh[r, j])
+                gl[q, j] = _nan_lo(_sub_lo(gl[q, j], gh[q, j], sl, sh))
+                gh[q, j] = _nan_hi(_sub_hi(gl[q, j], gh[q, j], sl, sh))
+            sl, sh = _term(ll, lh, zl[r], zh[r])
+            a, b = _sub_lo(zl[q], zh[q], sl, sh), _sub_hi(zl[q], zh[q], sl, sh)
+            zl[q], zh[q] = _nan_lo(a), _nan_hi(b)
+        steps = k + 1
+    return steps
 
 
 @nb.njit(cache=True, inline="always", error_model="numpy")
@@ -89,31 +250,27 @@ def _scale(p, lo, hi):
 
 
 @_njit
-def point_times(P, lo, hi):
-    """``P [lo, hi]`` for a real ``P`` (m, k) and an interval matrix ``(k, n)`` rounded
-    outward; returns ``(lo, hi)`` of shape (m, n). An inf - inf sum is the entire line. Only
-    the nonzero entries of each row of the interval matrix are visited (Jacobians of local
-    constraints are sparse)."""
+def point_times(P, lo, hi, rl, rh):
+    """``[rl, rh] = P [lo, hi]`` for a real ``P`` (m, k) and an interval matrix ``(k, n)``
+    rounded outward (``rl, rh`` (m, n) are written). An inf - inf sum is the entire line. Only
+    the nonzero entries of the interval matrix are visited (Jacobians of local constraints are
+    sparse)."""
     m, k = P.shape
     n = lo.shape[1]
-    rl = np.zeros((m, n))
-    rh = np.zeros((m, n))
-    nz = np.empty(n, dtype=np.int64)
-    for q in range(k):
-        cnt = 0
+    for i in range(m):
         for j in range(n):
-            if lo[q, j] != 0.0 or hi[q, j] != 0.0:
-                nz[cnt] = j
-                cnt += 1
-        if cnt == 0:
-            continue
-        for i in range(m):
-            p = P[i, q]
-            if p == 0.0:
+            rl[i, j] = 0.0
+            rh[i, j] = 0.0
+    for q in range(k):
+        for j in range(n):
+            ql, qh = lo[q, j], hi[q, j]
+            if ql == 0.0 and qh == 0.0:
                 continue
-            for t in range(cnt):
-                j = nz[t]
-                sl, sh = _scale(p, lo[q, j], hi[q, j])
+            for i in range(m):
+                p = P[i, q]
+                if p == 0.0:
+                    continue
+                sl, sh = _scale(p, ql, qh)
                 rl[i, j] = add_dn(rl[i, j], sl)
                 rh[i, j] = add_up(rh[i, j], sh)
     for i in range(m):
@@ -122,24 +279,28 @@ def point_times(P, lo, hi):
                 rl[i, j] = -INF
             if rh[i, j] != rh[i, j]:
                 rh[i, j] = INF
-    return rl, rh
 
 
 @_njit
-def contract_rows(al, ah, rl, rh, dl, dh):
-    """Contract ``d`` (in place) with the rows ``sum_j [a_ij] d_j in [r_i]``.
+def contract_rows(al, ah, rl, rh, dl, dh, reverse, work):
+    """Contract ``d`` (in place) with the rows ``sum_j [a_ij] d_j in [r_i]``, first to last
+    (last to first with ``reverse``).
 
-    ``al, ah`` (m, n), ``rl, rh`` (m,), ``dl, dh`` (n,). Returns False when some row has no
-    solution in the box (then ``d`` is partly updated and must be discarded), True otherwise.
+    ``al, ah`` (m, n), ``rl, rh`` (m,), ``dl, dh`` (n,), ``work`` (6, n + 1) scratch. In each
+    row, for ``j = 0 .. n - 1``, ``N = r - sum_{l != j} a_l d_l`` (prefix sums over the
+    already contracted ``d_0 .. d_{j-1}``, suffix sums over the others) and the product
+    ``a_j d_j in N`` is inverted both ways (relational division, as HC4 does on a product
+    node): ``a_j`` first, then ``d_j`` by the contracted ``a_j``, with the two-piece quotient
+    when ``a_j`` contains 0. The coefficient stays contracted in ``al, ah``: each row is one
+    relation ``s . d in r`` with its own real ``s`` in the row's intervals, so a later sweep of
+    the same rows may use it. Returns False when some row has no solution in the box (then
+    ``d`` is partly updated and must be discarded), True otherwise.
     """
     m, n = al.shape
-    pl = np.empty(n + 1)
-    ph = np.empty(n + 1)
-    ql = np.empty(n + 1)
-    qh = np.empty(n + 1)
-    tl = np.empty(n)
-    th = np.empty(n)
-    for i in range(m):
+    pl, ph, ql, qh = work[0], work[1], work[2], work[3]
+    tl, th = work[4], work[5]
+    for step in range(m):
+        i = m - 1 - step if reverse else step
         for j in range(n):
             tl[j], th[j] = _term(al[i, j], ah[i, j], dl[j], dh[j])
         pl[0] = ph[0] = 0.0
@@ -154,23 +315,24 @@ def contract_rows(al, ah, rl, rh, dl, dh):
         if pl[n] > rh[i] or ph[n] < rl[i]:
             return False
         for j in range(n):
-            if al[i, j] <= 0.0 <= ah[i, j]:
-                continue  # a divisor containing 0: no contraction from this row
+            if al[i, j] == 0.0 and ah[i, j] == 0.0:
+                pl[j + 1], ph[j + 1] = pl[j], ph[j]
+                continue
             # others = prefix(j) + suffix(j + 1), with the already contracted d_0..d_{j-1}
             ol = _nan_lo(add_dn(pl[j], ql[j + 1]))
             oh = _nan_hi(add_up(ph[j], qh[j + 1]))
-            nl = _sub_lo(rl[i], rh[i], ol, oh)
-            nh = _sub_hi(rl[i], rh[i], ol, oh)
-            xl = _div_lo(nl, nh, al[i, j], ah[i, j])
-            xh = _div_hi(nl, nh, al[i, j], ah[i, j])
-            if xl > dl[j]:
-                dl[j] = xl
-            if xh < dh[j]:
-                dh[j] = xh
-            if not dl[j] <= dh[j]:
+            nl = _nan_lo(_sub_lo(rl[i], rh[i], ol, oh))
+            nh = _nan_hi(_sub_hi(rl[i], rh[i], ol, oh))
+            if nl == -INF and nh == INF:
+                pl[j + 1] = _nan_lo(add_dn(pl[j], tl[j]))
+                ph[j + 1] = _nan_hi(add_up(ph[j], th[j]))
+                continue
+            a0, a1, x0, x1 = _mul_rev_all(nl, nh, al[i, j], ah[i, j], dl[j], dh[j])
+            if not (a0 <= a1 and x0 <= x1):
                 return False
-            # the prefix sums after j use the contracted d_j
-            tl[j], th[j] = _term(al[i, j], ah[i, j], dl[j], dh[j])
+            al[i, j], ah[i, j], dl[j], dh[j] = a0, a1, x0, x1
+            # the prefix sums after j use the contracted a_j and d_j
+            tl[j], th[j] = _term(a0, a1, x0, x1)
             pl[j + 1] = _nan_lo(add_dn(pl[j], tl[j]))
             ph[j + 1] = _nan_hi(add_up(ph[j], th[j]))
     return True
@@ -188,13 +350,31 @@ def _nan_hi(x):
 
 @nb.njit(cache=True, inline="always", error_model="numpy")
 def _term(al_, ah, xl, xh):
-    """``[a] [x]`` rounded outward, ``0 * inf = 0``, an empty result as the entire line."""
-    if al_ == 0.0 and ah == 0.0:
+    """``[a] [x]`` rounded outward, ``0 * inf = 0``, an empty result as the entire line. The
+    signs of the bounds select the extreme corners (two products, not eight)."""
+    if (al_ == 0.0 and ah == 0.0) or (xl == 0.0 and xh == 0.0):
         return 0.0, 0.0
-    if xl == 0.0 and xh == 0.0:
-        return 0.0, 0.0
-    lo = min(_mdn(al_, xl), _mdn(al_, xh), _mdn(ah, xl), _mdn(ah, xh))
-    hi = max(_mup(al_, xl), _mup(al_, xh), _mup(ah, xl), _mup(ah, xh))
+    if xl >= 0.0:
+        if al_ >= 0.0:
+            lo, hi = _mdn(al_, xl), _mup(ah, xh)
+        elif ah <= 0.0:
+            lo, hi = _mdn(al_, xh), _mup(ah, xl)
+        else:
+            lo, hi = _mdn(al_, xh), _mup(ah, xh)
+    elif xh <= 0.0:
+        if al_ >= 0.0:
+            lo, hi = _mdn(ah, xl), _mup(al_, xh)
+        elif ah <= 0.0:
+            lo, hi = _mdn(ah, xh), _mup(al_, xl)
+        else:
+            lo, hi = _mdn(ah, xl), _mup(al_, xl)
+    elif al_ >= 0.0:
+        lo, hi = _mdn(ah, xl), _mup(ah, xh)
+    elif ah <= 0.0:
+        lo, hi = _mdn(al_, xh), _mup(al_, xl)
+    else:
+        lo = min(_mdn(al_, xh), _mdn(ah, xl))
+        hi = max(_mup(al_, xl), _mup(ah, xh))
     return _nan_lo(lo), _nan_hi(hi)
 
 

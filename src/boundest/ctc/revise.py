@@ -21,7 +21,7 @@ from ..interval import arith as ar
 from ..interval import explog as el
 from ..interval import trig as tr
 
-__all__ = ["FAMILIES", "OP_CODES", "family_flags", "hc4_pass", "revise"]
+__all__ = ["FAMILIES", "OP_CODES", "family_flags", "hc4_pass", "revise", "revise_nodes"]
 
 OP_CODES = _C = {name: i for i, name in enumerate(OPS)}
 NEG, SQR, SQRT, EXP, LOG, SIN, COS, TAN = (_C[k] for k in
@@ -251,9 +251,20 @@ def hc4_pass(op, out, a, b, param, lo, hi, buf, piecewise, pown, explog, trig):
     slot only shrinks and holds every solution it held. Returns False as soon as a slot becomes
     empty (the slots are then partly updated: the box has no solution), True otherwise.
     """
+    return (revise_nodes(op, out, a, b, param, lo, hi, buf, False, piecewise, pown, explog,
+                         trig)
+            and revise_nodes(op, out, a, b, param, lo, hi, buf, True, piecewise, pown, explog,
+                             trig))
+
+
+@nb.njit(cache=True, error_model="numpy")
+def revise_nodes(op, out, a, b, param, lo, hi, buf, backward, piecewise, pown, explog, trig):
+    """Revise every node of a tape once, in tape order (last to first with ``backward``: the
+    backward half of :func:`hc4_pass`, which is all a pass needs when the slots already hold
+    the forward images); returns False as soon as a slot becomes empty."""
     n = op.size
-    for step in range(2 * n):
-        i = step if step < n else 2 * n - 1 - step
+    for step in range(n):
+        i = n - 1 - step if backward else step
         o, ia, ib = out[i], a[i], b[i]
         yl, yh = (lo[ib], hi[ib]) if ib >= 0 else (0.0, 0.0)
         zl, zh, xl, xh, yl, yh = revise(op[i], lo[o], hi[o], lo[ia], hi[ia], yl, yh, param[i],
