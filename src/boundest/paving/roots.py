@@ -15,14 +15,16 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+import numba as nb
 import numpy as np
 from numpy.typing import NDArray
 
-from ..ctc import CtcFwdBwd
 from ..ctc.centered import CtcNewton
 from ..ctc.derivatives import jacobian_sparse
+from ..ctc.revise import family_flags, hc4_pass
 from ..expr.function_tape import constraint_functions
 from ..expr.model import Model
+from ..expr.tape import compile_model
 from ..interval import Interval
 
 __all__ = ["Roots", "solve_square"]
@@ -70,11 +72,52 @@ class Roots:
                 f"{int((~self.proved).sum())} undecided boxes)")
 
 
+@nb.njit(cache=True, error_model="numpy")
+def _hc4_batch(op, out, a, b, param, slot_lo, slot_hi, var_slots, xl, xh, passes,
+               piecewise, pown, explog, trig):
+    """Forward-backward passes (:func:`boundest.ctc.revise.hc4_pass`, compiled) on each box
+    ``(xl[i], xh[i])`` of the model's constraint tape, in place (NaN bounds: no solution)."""
+    buf = np.empty(4)
+    for i in range(xl.shape[0]):
+        lo = slot_lo.copy()
+        hi = slot_hi.copy()
+        for j in range(var_slots.size):
+            s = var_slots[j]
+            lo[s] = max(lo[s], xl[i, j])
+            hi[s] = min(hi[s], xh[i, j])
+        ok = True
+        for _ in range(passes):
+            if not hc4_pass(op, out, a, b, param, lo, hi, buf, piecewise, pown, explog, trig):
+                ok = False
+                break
+        for j in range(var_slots.size):
+            s = var_slots[j]
+            xl[i, j] = lo[s] if ok else np.nan
+            xh[i, j] = hi[s] if ok else np.nan
+
+
+class _HC4:
+    """Hull consistency of a model on a batch of boxes (a few compiled passes per box)."""
+
+    def __init__(self, model: Model, names: list[str], passes: int = 3) -> None:
+        self.tape = compile_model(model)
+        self.slots = np.array([self.tape.slot_of[v] for v in names], dtype=np.int64)
+        self.flags = family_flags(self.tape.op)
+        self.passes = passes
+
+    def __call__(self, x: Interval) -> Interval:
+        t = self.tape
+        lo, hi = x.lo.copy(), x.hi.copy()
+        _hc4_batch(t.op, t.out, t.a, t.b, t.param, t.lo, t.hi, self.slots, lo, hi,
+                   self.passes, *self.flags)
+        return Interval._new(lo, hi)
+
+
 def _nonempty(x: Interval) -> NDArray[np.bool_]:
     return ~np.isnan(x.lo).any(axis=-1)
 
 
-def _newton_rounds(newton: CtcNewton, hc4: CtcFwdBwd | None, x: Interval, rounds: int
+def _newton_rounds(newton: CtcNewton, hc4: _HC4 | None, x: Interval, rounds: int
                    ) -> tuple[Interval, NDArray[np.bool_]]:
     """Alternate Newton and hull consistency while some box still shrinks by 10 %.
 
@@ -162,7 +205,7 @@ def solve_square(system: Model | Sequence, box: Interval | None = None, *, eps: 
     if not eps > 0:
         raise ValueError(f"eps must be positive, got {eps}")
     newton = CtcNewton(tape)
-    hc4 = CtcFwdBwd(model, list(tape.names))
+    hc4 = _HC4(model, list(tape.names))
     frontier = box[None, :]
     proved_boxes: list[Interval] = []
     undecided: list[Interval] = []
