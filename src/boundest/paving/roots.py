@@ -76,9 +76,16 @@ class Roots:
 def _hc4_batch(op, out, a, b, param, slot_lo, slot_hi, var_slots, xl, xh, passes,
                piecewise, pown, explog, trig):
     """Forward-backward passes (:func:`boundest.ctc.revise.hc4_pass`, compiled) on each box
-    ``(xl[i], xh[i])`` of the model's constraint tape, in place (NaN bounds: no solution)."""
+    ``(xl[i], xh[i])`` of the model's constraint tape, in place (NaN bounds: no solution).
+
+    An empty box (NaN bounds, e.g. refuted by Newton) stays empty: ``max(lo, nan)`` would keep
+    the slot's initial domain and bring the whole domain back."""
     buf = np.empty(4)
     for i in range(xl.shape[0]):
+        if not np.all(xl[i] <= xh[i]):
+            xl[i, :] = np.nan
+            xh[i, :] = np.nan
+            continue
         lo = slot_lo.copy()
         hi = slot_hi.copy()
         for j in range(var_slots.size):
