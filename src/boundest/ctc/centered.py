@@ -36,7 +36,14 @@ from ..interval import Interval
 from ..interval.rounding import add_dn, add_up, mul_up, sub_dn, sub_up
 from .base import Contractor, _empty_rows
 from .derivatives import evaluate, jacobian_sparse, midpoint
-from .linear_forms import _term, contract_rows, point_times, preconditioner
+from .linear_forms import (
+    _term,
+    contract_rows,
+    csr_times,
+    point_times,
+    preconditioner,
+    square_preconditioner,
+)
 
 __all__ = ["CtcCentered", "CtcNewton"]
 
@@ -198,7 +205,7 @@ def _newton_kernel(el, eh, row_ptr, cols, fcl, fch, ok, tl, th, xl, xh, c, prove
         if not np.all(xl[bx] <= xh[bx]) or np.any(np.isnan(fcl[bx])):
             continue
         jl, jh = _dense(el[bx], eh[bx], row_ptr, cols, n)
-        P0, pivot = preconditioner(_midpoints(jl, jh))
+        P0, pivot = square_preconditioner(_midpoints(jl, jh))
         P = np.zeros((n, n))
         full = True
         for r in range(n):
@@ -209,7 +216,7 @@ def _newton_kernel(el, eh, row_ptr, cols, fcl, fch, ok, tl, th, xl, xh, c, prove
         if not full:
             P = P0
         zl, zh = _rhs(tl, th, fcl[bx], fch[bx])
-        ml, mh = point_times(P, jl, jh)
+        ml, mh = csr_times(P, el[bx], eh[bx], row_ptr, cols, n)
         rl, rh = point_times(P, zl.reshape(-1, 1), zh.reshape(-1, 1))
         dl = np.empty(n)
         dh = np.empty(n)

@@ -25,7 +25,7 @@ import numpy as np
 from ..interval.rounding import add_dn, add_up, mul_dn, mul_up
 from .revise import _div_hi, _div_lo, _sub_hi, _sub_lo
 
-__all__ = ["contract_rows", "point_times", "preconditioner"]
+__all__ = ["contract_rows", "csr_times", "point_times", "preconditioner", "square_preconditioner"]
 
 _njit = nb.njit(cache=True, error_model="numpy")
 INF = math.inf
@@ -195,3 +195,130 @@ def _mdn(a, b):
 @nb.njit(cache=True, inline="always", error_model="numpy")
 def _mup(a, b):
     return 0.0 if (a == 0.0 or b == 0.0) else mul_up(a, b)
+
+
+@_njit
+def square_preconditioner(A):
+    """``(P, pivot)`` as :func:`preconditioner` for a square ``A``, by LU with partial pivoting
+    that skips zero entries: ``P ~ A^-1`` (``pivot[i] = i``), each row of ``P`` without its
+    entries below ``1e-20`` times its largest (the inverse of a banded matrix decays away from
+    the band), in about ``O(n nnz(L + U))`` where the full-pivoting Gauss-Jordan elimination is
+    ``O(n^3)`` (a banded Jacobian of 1000 unknowns: a few ms against 0.7-2 s). A pivot below
+    ``1e-13`` times the largest entry of ``A`` (singular or nearly so) hands the matrix to
+    :func:`preconditioner`, which copes with rank deficiency. Any real ``P`` is sound; this one
+    only decides how much the rows contract.
+    """
+    n = A.shape[0]
+    scale = 0.0
+    for i in range(n):
+        for j in range(n):
+            scale = max(scale, abs(A[i, j]))
+    if not scale > 0.0 or not math.isfinite(scale):
+        return preconditioner(A)
+    LU = A.copy()
+    row = np.arange(n)  # row k of LU is row row[k] of A
+    last = np.zeros(n, dtype=np.int64)  # the last nonzero column of each row of LU
+    for i in range(n):
+        for j in range(n - 1, -1, -1):
+            if LU[i, j] != 0.0:
+                last[i] = j
+                break
+    for k in range(n):
+        p, best = k, abs(LU[k, k])
+        for i in range(k + 1, n):
+            if abs(LU[i, k]) > best:
+                p, best = i, abs(LU[i, k])
+        if not best > 1e-13 * scale:
+            return preconditioner(A)
+        if p != k:
+            for j in range(n):
+                LU[k, j], LU[p, j] = LU[p, j], LU[k, j]
+            row[k], row[p] = row[p], row[k]
+            last[k], last[p] = last[p], last[k]
+        inv = 1.0 / LU[k, k]
+        for i in range(k + 1, n):
+            if LU[i, k] != 0.0:
+                f = LU[i, k] * inv
+                LU[i, k] = f
+                for j in range(k + 1, last[k] + 1):
+                    LU[i, j] -= f * LU[k, j]
+                last[i] = max(last[i], last[k])
+    # P = U^-1 L^-1 (rows permuted): forward then back substitution, one row of P at a time,
+    # each row kept within the span of its nonzero columns; an entry below 1e-20 times the
+    # largest of its row is dropped (the inverse of a banded matrix decays away from the band:
+    # what is dropped would only add subnormal arithmetic, and any real P is sound)
+    P = np.zeros((n, n))
+    c0 = np.empty(n, dtype=np.int64)
+    c1 = np.empty(n, dtype=np.int64)
+    for i in range(n):
+        P[i, row[i]] = 1.0
+        a, b = row[i], row[i]
+        for j in range(i):
+            f = LU[i, j]
+            if f != 0.0 and c0[j] <= c1[j]:
+                for c in range(c0[j], c1[j] + 1):
+                    P[i, c] -= f * P[j, c]
+                a, b = min(a, c0[j]), max(b, c1[j])
+        c0[i], c1[i] = _trim(P, i, a, b)
+    for i in range(n - 1, -1, -1):
+        a, b = c0[i], c1[i]
+        for j in range(i + 1, last[i] + 1):
+            f = LU[i, j]
+            if f != 0.0 and c0[j] <= c1[j]:
+                for c in range(c0[j], c1[j] + 1):
+                    P[i, c] -= f * P[j, c]
+                a, b = min(a, c0[j]), max(b, c1[j])
+        inv = 1.0 / LU[i, i]
+        for c in range(a, b + 1):
+            P[i, c] *= inv
+        c0[i], c1[i] = _trim(P, i, a, b)
+    for i in range(n):
+        for c in range(c0[i], c1[i] + 1):
+            if not math.isfinite(P[i, c]):
+                return preconditioner(A)
+    return P, np.arange(n)
+
+
+@_njit
+def _trim(P, i, a, b):
+    """Zero the entries of row ``i`` of ``P`` in columns ``a..b`` below ``1e-20`` times the
+    largest; returns the span of what is left (``a > b`` if nothing)."""
+    big = 0.0
+    for c in range(a, b + 1):
+        big = max(big, abs(P[i, c]))
+    cut = 1e-20 * big
+    lo, hi = b + 1, a - 1
+    for c in range(a, b + 1):
+        if abs(P[i, c]) < cut or P[i, c] == 0.0:
+            P[i, c] = 0.0
+        else:
+            lo, hi = min(lo, c), max(hi, c)
+    return lo, hi
+
+
+@_njit
+def csr_times(P, el, eh, row_ptr, cols, n):
+    """``P [J]`` rounded outward for a real ``P`` (m, k) and an interval matrix ``[J]`` (k, n)
+    given by its nonzero entries in CSR form (row ``q``: columns ``cols[row_ptr[q]:row_ptr[q +
+    1]]``, bounds ``el``, ``eh``): what :func:`point_times` gives on the dense matrix, in
+    ``O(m nnz)``. An inf - inf sum is the entire line."""
+    m, k = P.shape
+    rl = np.zeros((m, n))
+    rh = np.zeros((m, n))
+    for i in range(m):
+        for q in range(k):
+            p = P[i, q]
+            if p == 0.0:
+                continue
+            for t in range(row_ptr[q], row_ptr[q + 1]):
+                j = cols[t]
+                sl, sh = _scale(p, el[t], eh[t])
+                rl[i, j] = add_dn(rl[i, j], sl)
+                rh[i, j] = add_up(rh[i, j], sh)
+    for i in range(m):
+        for j in range(n):
+            if rl[i, j] != rl[i, j]:
+                rl[i, j] = -INF
+            if rh[i, j] != rh[i, j]:
+                rh[i, j] = INF
+    return rl, rh
