@@ -103,13 +103,17 @@ def broyden(n: int, r: float = 100.0) -> Problem:
 
 def _brown_eqs(x, _lib):
     n = len(x)
-    total = x[0]
-    for v in x[1:]:
-        total = total + v
+    out = []
+    for i in range(n - 1):  # as Brown-05.bch writes it: 2 x_i + sum_{j != i} x_j - (n + 1)
+        s = 2 * x[i]
+        for j in range(n):
+            if j != i:
+                s = s + x[j]
+        out.append(s - (n + 1))
     prod = x[0]
     for v in x[1:]:
         prod = prod * v
-    return [x[i] + total - (n + 1) for i in range(n - 1)] + [prod - 1]
+    return [*out, prod - 1]
 
 
 def brown(n: int = 5) -> Problem:
