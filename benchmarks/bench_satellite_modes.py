@@ -7,7 +7,10 @@ others (cheaper, tighter), ``bc`` (box consistency of the states, ``mode="bc"``)
 ``lp`` (LP contraction of the linear rows at the fixed point, ``mode="lp"``, side by side with
 ``csp.linear.propagate_lp``, which restarts hull consistency after each LP), ``lp + relax`` (the
 LPs also over the linear relaxation of the nonlinear nodes around the box,
-``LinearRelaxation(relax=True)``) and ``3b`` then ``lp + relax`` from its box, on the embedded data
+``LinearRelaxation(relax=True)``) and ``3b`` then ``lp + relax`` from its box, ``centered``
+and ``3b+centered`` (the centered form of windows of steps with optimal multipliers,
+``mode="3b+centered"`` with the settings of ``boundest run satellite``, and variants), on the
+embedded data
 at k_max = 200 (``satellite_k200.csv``) and 800
 (``satellite_k800.csv``). Per mode and data set: the median propagation time over ``--repeat``
 runs after a warm-up, the mean width of each state component over k = 0..k_max, the widest x1
@@ -58,7 +61,7 @@ LP = {"radius": 12, "log_linear": False}
 def _modes():
     """``(label, mode, keyword arguments of propagate)``; mode ``propagate_lp`` is
     ``csp.linear.propagate_lp``."""
-    from boundest.csp import BoxConsistency, LinearRelaxation, Shaving
+    from boundest.csp import BoxConsistency, Centered, LinearRelaxation, Shaving
     from boundest.scenarios import satellite as sat
 
     return [("hc4", "hc4", {}),
@@ -86,7 +89,17 @@ def _modes():
             ("lp + relax (radius=12, linear + relaxed rows, 3 rounds)", "lp",
              {"linear": LinearRelaxation(**LP, relax=True)}),
             ("3b default, then lp + relax (radius=12, 1 round)", "3b+lp",
-             {"shaving": sat.SHAVING, "linear": LinearRelaxation(**LP, rounds=1, relax=True)})]
+             {"shaving": sat.SHAVING, "linear": LinearRelaxation(**LP, rounds=1, relax=True)}),
+            ("centered (satellite.CENTERED, after hc4)", "centered",
+             {"centered": sat.CENTERED}),
+            ("3b+centered default (satellite.SHAVING_CENTERED, CENTERED)", "3b+centered",
+             {"shaving": sat.SHAVING_CENTERED, "centered": sat.CENTERED}),
+            ("3b+centered, window=42", "3b+centered",
+             {"shaving": sat.SHAVING_CENTERED, "centered": Centered(window=42, rounds=2)}),
+            ("3b+centered, window=70, 3 rounds", "3b+centered",
+             {"shaving": sat.SHAVING_CENTERED, "centered": Centered(window=70, rounds=3)}),
+            ("3b default, then centered (satellite.CENTERED)", "3b+centered",
+             {"shaving": sat.SHAVING, "centered": sat.CENTERED})]
 
 
 def _lp_like(mode: str) -> bool:
@@ -113,7 +126,7 @@ def _once(tape, names, mode, kw):
         return r, time.perf_counter() - t0, info
     r = propagate(tape, mode=mode, shave=names, targets=names, progress=False, **kw)
     info = {"evaluations": r.evaluations, "shaving": r.shaving, "boxcons": r.boxcons,
-            "linear": r.linear}
+            "linear": r.linear, "centered": r.centered}
     return r, r.time_s, info
 
 

@@ -115,3 +115,56 @@ def test_mode_option_runs_each_mode_and_reports_its_cost(tmp_path, capsys):
     assert widths["hc4"] == 20.0 and widths["bc"] < 1.1 and widths["bc+3b"] <= widths["bc"]
     with pytest.raises(SystemExit):
         main(["solve", str(f), "--mode", "bc3"])
+
+
+def test_a_square_system_is_solved_by_interval_newton_with_proofs(tmp_path, capsys):
+    """Two circles meet in two points: --paving on a square model proves both, writes them as
+    proved in the JSON and draws them; the boxes hold the exact intersections."""
+    import math
+
+    f, js = tmp_path / "circles.txt", tmp_path / "c.json"
+    f.write_text("x in [-3, 3], y in [-3, 3];\nConstraints\nx^2 + y^2 = 4, "
+                 "(x - 1)^2 + y^2 = 2;\n")
+    assert main(["solve", str(f), "--paving", "1e-8", "--out", str(tmp_path), "--json",
+                 str(js)]) == 0
+    out = capsys.readouterr().out
+    assert "interval Newton" in out and "2 solutions proved" in out and "0 undecided" in out
+    data = json.loads(js.read_text())["paving"]
+    assert data["method"] == "newton" and data["proved"] == [True, True]
+    x = 1.5  # x^2 - (x - 1)^2 = 2
+    for y in (math.sqrt(4 - x * x), -math.sqrt(4 - x * x)):
+        assert any(b[0][0] <= x <= b[0][1] and b[1][0] <= y <= b[1][1]
+                   for b in data["boxes"]), y
+    assert (tmp_path / "circles_paving.png").stat().st_size > 5_000
+
+
+def test_a_double_root_is_undecided_never_proved(tmp_path, capsys):
+    f, js = tmp_path / "double.txt", tmp_path / "d.json"
+    f.write_text("x in [-1, 1], y in [-1, 1];\nConstraints\nx^2 = 0, y - x = 0;\n")
+    assert main(["solve", str(f), "--paving", "1e-6", "--out", str(tmp_path), "--json",
+                 str(js)]) == 0
+    assert "0 solutions proved" in capsys.readouterr().out
+    data = json.loads(js.read_text())["paving"]
+    assert data["boxes"] and not any(data["proved"])
+    assert any(b[0][0] <= 0 <= b[0][1] and b[1][0] <= 0 <= b[1][1] for b in data["boxes"])
+
+
+@pytest.mark.parametrize("mode", ["centered", "3b+centered"])
+def test_centered_modes_narrow_what_hull_consistency_cannot(tmp_path, capsys, mode):
+    """x + y = 1 and x - y = 0 on [0, 1]^2: each constraint alone allows all of [0, 1], the
+    linearisation of the pair gives the point 1/2."""
+    f, js = tmp_path / "m.txt", tmp_path / "m.json"
+    f.write_text("x in [0, 1], y in [0, 1];\nConstraints\nx + y + 0.1 * x * y = 1.1, "
+                 "x - y = 0;\n")
+    assert main(["solve", str(f), "--json", str(tmp_path / "h.json")]) == 0
+    hc = json.loads((tmp_path / "h.json").read_text())["domains"]["x"]
+    assert hc == [0.0, 1.0]
+    assert main(["solve", str(f), "--mode", mode, "--json", str(js)]) == 0
+    assert f"mode {mode}:" in capsys.readouterr().out
+    x = json.loads(js.read_text())["domains"]["x"]
+    import mpmath
+
+    with mpmath.workdps(50):  # the decimal literals are exact: 0.1 x^2 + 2 x - 1.1 = 0
+        a, c = mpmath.mpf("0.1"), mpmath.mpf("1.1")
+        root = (-2 + mpmath.sqrt(4 + 4 * a * c)) / (2 * a)
+        assert mpmath.mpf(x[0]) <= root <= mpmath.mpf(x[1]) and x[1] - x[0] < 1e-6

@@ -24,21 +24,23 @@ _keep_freed_memory()  # glibc: no page faults for re-allocated temporaries (see 
 #: name -> submodule that defines it (the interval names and the dispatching elementary
 #: functions are looked up in ``interval`` and ``expr.functions``, see ``__getattr__``)
 _NAMES: dict[str, str] = {
-    **dict.fromkeys(("Arc", "BetaResult", "Propagation", "TreeSCSP", "beta_tuning",
-                     "propagate"), "csp"),
-    **dict.fromkeys(("Contractor", "CtcFwdBwd", "CtcQInter", "Fixpoint", "FunctionContractor",
-                     "Inflate", "Sequence", "Union"), "ctc"),
+    **dict.fromkeys(("Arc", "BetaResult", "Centered", "Propagation", "Shaving", "TreeSCSP",
+                     "beta_tuning", "propagate"), "csp"),
+    **dict.fromkeys(("Contractor", "CtcCentered", "CtcFwdBwd", "CtcNewton", "CtcQInter",
+                     "Fixpoint", "FunctionContractor", "Inflate", "Sequence", "Union",
+                     "centered_form", "jacobian"), "ctc"),
     **dict.fromkeys(("ChainEstimate", "DiscreteSystem", "cse", "ncse", "rcse", "rcse_ncse"),
                     "estimation"),
     **dict.fromkeys(("Constraint", "Model", "ModelSyntaxError", "Var", "VarFamily",
                      "load_model", "parse_model"), "expr"),
-    **dict.fromkeys(("Subpaving", "image", "separators", "sivia"), "paving"),
+    **dict.fromkeys(("Roots", "Subpaving", "image", "separators", "sivia", "solve_square"),
+                    "paving"),
     **dict.fromkeys(("ContractorNetwork", "CtcDeriv", "CtcEval", "CtcSlices", "NetworkReport",
                      "Tube", "TubeVector"), "tube"),
     **dict.fromkeys(("abs", "min", "max", "pow"), "expr.functions"),
     "Box": "interval",
 }
-_ALIASES = {"Box": "IntervalVector"}
+_ALIASES = {"Box": "IntervalVector", "centered_form": "centered"}
 _SUBPACKAGES = ("interval", "expr", "ctc", "csp", "paving", "tube", "estimation", "scenarios",
                 "plot", "commands", "cli")
 

@@ -18,7 +18,7 @@ from . import save_figure, subplots, write_json
 
 #: ``boundest.csp.MODES``, spelt out here so that ``boundest --help`` does not import Numba
 #: (``tests/test_solve_cli.py`` checks that the two agree)
-PROPAGATION_MODES = ("hc4", "bc", "3b", "bc+3b", "lp")
+PROPAGATION_MODES = ("hc4", "bc", "3b", "bc+3b", "lp", "centered", "3b+centered")
 
 #: Subpavings are computed for models of at most this many variables (SIVIA bisects every
 #: dimension; beyond a few the number of boxes explodes).
@@ -266,7 +266,7 @@ def run(args: argparse.Namespace) -> int:
             hull = paving.hull()
             print("  hull: " + ", ".join(f"{n} in [{float(a):.6g}, {float(b):.6g}]" for n, a, b
                                          in zip(res.domains, hull.lo, hull.hi, strict=True)))
-        data["paving"] = {"eps": eps, "variables": list(res.domains),
+        data["paving"] = {"eps": eps, "method": "sivia", "variables": list(res.domains),
                           "boxes": paving.boxes, "stopped": st.get("stopped")}
         if paving.dim >= 2 and not empty:
             from ..plot.paving import plot_paving
@@ -297,14 +297,18 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "of its width (default 1e-3)")
     p.add_argument("--mode", choices=PROPAGATION_MODES, default="hc4",
                    help="hull consistency alone (hc4, default), then box consistency (bc), "
-                        "3B shaving (3b), both (bc+3b) or LP contraction (lp, needs the lp "
-                        "extra); see boundest.csp.propagate")
+                        "3B shaving (3b), both (bc+3b), LP contraction (lp, needs the lp "
+                        "extra), the centered form of windows of constraints (centered) or "
+                        "shaving then the centered form (3b+centered); see "
+                        "boundest.csp.propagate and docs/derivatives.md")
     p.add_argument("--all", action="store_true",
                    help="print every variable's domain instead of the summary")
     p.add_argument("--paving", type=float, metavar="EPS",
                    help="after propagation, bisect with SIVIA to boxes narrower than EPS: an "
                         f"outer subpaving (for models of at most {MAX_PAVING_VARIABLES} "
-                        "bounded variables; overrides the file's 'Bisection' option)")
+                        "bounded variables; overrides the file's 'Bisection' option); a square "
+                        "system (as many equations as variables, nothing else) is solved by "
+                        "interval Newton instead, which proves solutions")
     p.add_argument("--max-boxes", type=int, default=100_000,
                    help="SIVIA stops before exceeding this many boxes (default 100000)")
     p.add_argument("--out", default="out", help="folder for the subpaving figure (default: out)")

@@ -3,8 +3,16 @@ FALL/CLIMB on trees; beta-tuning."""
 
 from .beta import BetaResult, beta_tuning
 from .boxcons import CtcBox
-from .propagate import MODES, BoxConsistency, LinearRelaxation, Propagation, Shaving, propagate
+from .propagate import (
+    MODES,
+    BoxConsistency,
+    Centered,
+    LinearRelaxation,
+    Propagation,
+    Shaving,
+    propagate,
+)
 from .tree import Arc, TreeSCSP
 
-__all__ = ["MODES", "Arc", "BetaResult", "BoxConsistency", "CtcBox", "LinearRelaxation",
+__all__ = ["MODES", "Arc", "BetaResult", "BoxConsistency", "Centered", "CtcBox", "LinearRelaxation",
            "Propagation", "Shaving", "TreeSCSP", "beta_tuning", "propagate"]

@@ -1,6 +1,8 @@
 """Propagation of a CSP to a fixed point: hull consistency on its primitive decomposition
 (``mode="hc4"``), and on top of it box consistency (``"bc"``), 3B consistency by shaving
-(``"3b"``), both (``"bc+3b"``), or LP contraction of the linear sub-networks (``"lp"``)."""
+(``"3b"``), both (``"bc+3b"``), LP contraction of the linear sub-networks (``"lp"``), or the
+centered form of windows of constraints with optimal multipliers (``"centered"``, and
+``"3b+centered"`` after shaving)."""
 
 from __future__ import annotations
 
@@ -26,12 +28,13 @@ from .engine import (
     shave_kernel,
 )
 
-__all__ = ["MODES", "BoxConsistency", "LinearRelaxation", "Propagation", "Shaving",
-           "arg_users", "bc_candidates", "propagate", "slot_users"]
+__all__ = ["MODES", "BoxConsistency", "Centered", "LinearRelaxation", "Propagation",
+           "Shaving", "arg_users", "bc_candidates", "propagate", "slot_users"]
 
 #: The propagation modes: hull consistency alone, then box consistency, 3B shaving, box
-#: consistency and shaving, or LP contraction (see ``propagate``).
-MODES = ("hc4", "bc", "3b", "bc+3b", "lp")
+#: consistency and shaving, LP contraction, the centered form of windows of constraints, or
+#: shaving then the centered form (see ``propagate``).
+MODES = ("hc4", "bc", "3b", "bc+3b", "lp", "centered", "3b+centered")
 
 
 @dataclass(frozen=True)
@@ -158,6 +161,42 @@ class LinearRelaxation:
             raise ValueError(f"radius must be at least 1, got {self.radius}")
 
 
+@dataclass(frozen=True)
+class Centered:
+    """Settings of the centered-form modes (``propagate(mode="centered")`` and
+    ``"3b+centered"``; :mod:`boundest.ctc.windows` details the contraction).
+
+    Attributes
+    ----------
+    window : int
+        Consecutive constraints (in the model's order) linearised together: each target is
+        contracted by the optimal aggregation of the constraints of one window (the one where
+        it lies most central). Wider windows see further along a chain and cost more per
+        target (a dense simplex over the window).
+    stride : int, optional
+        Constraints between the starts of two windows (default ``window // 2``).
+    rounds : int
+        Linearisations at most (each followed by hull consistency on what it narrowed).
+    min_gain : float
+        Stop when a round narrows the targets' total width by less than this fraction.
+    """
+
+    window: int = 42
+    stride: int | None = None
+    rounds: int = 2
+    min_gain: float = 0.01
+
+    def __post_init__(self) -> None:
+        if self.window < 1:
+            raise ValueError(f"window must be at least 1, got {self.window}")
+        if self.stride is not None and not 1 <= self.stride <= self.window:
+            raise ValueError(f"stride must lie in 1..window, got {self.stride}")
+        if self.rounds < 1:
+            raise ValueError(f"rounds must be at least 1, got {self.rounds}")
+        if self.min_gain < 0:
+            raise ValueError("min_gain must be non-negative")
+
+
 @dataclass
 class Propagation:
     """Result of ``propagate``.
@@ -191,6 +230,12 @@ class Propagation:
         rigorous bounds), ``evaluations`` (revisions propagating what the LPs narrowed),
         ``widths`` (the targets' total width after hull consistency and after each round) and
         ``time_s``; empty otherwise.
+    centered : dict
+        With ``mode="centered"`` or ``"3b+centered"``: ``rounds``, the counters of the window
+        contraction (``ctc.windows.WINDOW_STATS``: windows, linear programmes solved, not
+        solved, bounds narrowed), ``evaluations`` (revisions propagating what it narrowed),
+        ``widths`` (the targets' total width before and after each round), ``prepare_s``
+        (differentiable form of the constraints, windows) and ``time_s``; empty otherwise.
     """
 
     domains: dict[str, Interval]
@@ -205,6 +250,7 @@ class Propagation:
     shaving: dict = field(default_factory=dict)
     boxcons: dict = field(default_factory=dict)
     linear: dict = field(default_factory=dict)
+    centered: dict = field(default_factory=dict)
 
     def __getitem__(self, name: str) -> Interval:
         return self.domains[name]
@@ -271,7 +317,8 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
               mode: str = "hc4", shave: list[str] | None = None,
               shaving: Shaving | None = None, targets: list[str] | None = None,
               boxcons: BoxConsistency | None = None,
-              linear: LinearRelaxation | None = None) -> Propagation:
+              linear: LinearRelaxation | None = None,
+              centered: Centered | None = None) -> Propagation:
     """Contract all domains of a CSP to a fixed point.
 
     ``mode="hc4"`` is hull consistency: every primitive node revised until nothing moves.
@@ -298,6 +345,16 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
     propagate_lp`` it never restarts propagation from scratch. The LPs are global: their cost
     grows faster than the CSP.
 
+    ``mode="centered"`` linearises the constraints around the centre of the box (the
+    mean-value form with the interval Jacobian, :mod:`boundest.ctc.derivatives`), which keeps
+    the first-order correlation between variables that boxes lose, and contracts each variable
+    of ``targets`` by the best aggregation of the constraints of a window of ``centered.window``
+    consecutive constraints (:mod:`boundest.ctc.windows`: a compiled simplex chooses the
+    multipliers, interval arithmetic makes the bound rigorous), then propagates what narrowed
+    by hull consistency, round after round while it pays. The cost per target is one small
+    dense simplex, so the cost per step of a chain stays flat. ``"3b+centered"`` shaves first
+    (``shave``, ``shaving``): the linearisation pays most on boxes that are already narrow.
+
     Stopping rule: a node is revised again only when one of its slots shrank by more than
     ``rel_eps`` times its width (or lost an infinite bound); propagation stops when no such
     node is left (the fixed point at that tolerance), when a domain becomes empty (the CSP is
@@ -321,8 +378,9 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
         Consecutive tape nodes brought to their local fixed point together before a pass moves
         on (see ``engine.propagate_kernel``); 64 nodes is about three time steps of the
         satellite.
-    mode : {"hc4", "bc", "3b", "bc+3b", "lp"}
-        Hull consistency alone, or followed by box consistency, shaving, both, or LPs.
+    mode : {"hc4", "bc", "3b", "bc+3b", "lp", "centered", "3b+centered"}
+        Hull consistency alone, or followed by box consistency, shaving, both, LPs, the
+        centered form, or shaving and the centered form.
     shave : list of str, optional
         With ``mode="3b"``: the variables to shave, in the order they are visited (for a time
         series, by time step; default: every variable of the model in its order).
@@ -332,11 +390,15 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
         With ``mode="bc"`` or ``"bc+3b"``: the variables box consistency narrows (those among
         them that occur several times; default: every variable); with ``mode="lp"``: the
         variables the LPs contract (default: every variable; each costs two LPs, four where it
-        is sign-definite and in a log-linear row).
+        is sign-definite and in a log-linear row); with ``mode="centered"`` or
+        ``"3b+centered"``: the variables the centered form contracts (default: every variable;
+        each costs two small linear programmes per round).
     boxcons : BoxConsistency, optional
         With ``mode="bc"`` or ``"bc+3b"``: the settings (default ``BoxConsistency()``).
     linear : LinearRelaxation, optional
         With ``mode="lp"``: the settings (default ``LinearRelaxation()``).
+    centered : Centered, optional
+        With ``mode="centered"`` or ``"3b+centered"``: the settings (default ``Centered()``).
     """
     if mode not in MODES:
         raise ValueError(f"mode must be one of {', '.join(MODES)}, got {mode!r}")
@@ -345,6 +407,9 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
     if window < 1:
         raise ValueError(f"window must be a positive number of nodes, got {window}")
     tape = model if isinstance(model, Tape) else compile_model(model)
+    if mode in ("centered", "3b+centered") and tape.model is None:
+        raise ValueError(f"mode {mode!r} differentiates the model's constraints: pass the Model "
+                         "(or a Tape from compile_model), not a Tape without its model")
     if mode == "lp":
         from ..ctc.linear import _linprog
 
@@ -379,7 +444,7 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
         repropagate_kernel(tape.op[e], tape.out[e], tape.a[e], tape.b[e], tape.param[e], lo[e],
                            hi[e], ptr[:1], adj[e], adj[e], rel_eps, window,
                            np.zeros(1, dtype=np.int64), *families)
-    if mode in ("3b", "bc+3b"):
+    if mode in ("3b", "bc+3b", "3b+centered"):
         shave_kernel(tape.op[e], tape.out[e], tape.a[e], tape.b[e], tape.param[e], lo[e], hi[e],
                      ptr[:1], adj[e], np.zeros(0, dtype=np.int64), rel_eps, rel_eps, 1, 0.5, 1,
                      0, 0.0, window, np.zeros(len(SHAVE_STATS), dtype=np.int64), *families)
@@ -425,7 +490,7 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
                                      _shave_slots(tape, targets, "targets"),
                                      linear or LinearRelaxation())
         evaluations += lp_info["evaluations"]
-    if mode in ("3b", "bc+3b") and status != EMPTY and n > 0:
+    if mode in ("3b", "bc+3b", "3b+centered") and status != EMPTY and n > 0:
         cand = _shave_slots(tape, shave)
         opts = shaving or Shaving()
         stats = np.zeros(len(SHAVE_STATS), dtype=np.int64)
@@ -437,6 +502,11 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
         shave_info = {k: int(v) for k, v in zip(SHAVE_STATS, stats, strict=True)}
         shave_info["time_s"] = time.perf_counter() - t1
         evaluations += int(stats[-1])
+    ctr_info: dict = {}
+    if mode in ("centered", "3b+centered") and status != EMPTY and n > 0:
+        status, ctr_info = _centered_rounds(tape, lo, hi, ptr, adj, families, rel_eps, window,
+                                            targets, centered or Centered())
+        evaluations += ctr_info["evaluations"]
     elapsed = time.perf_counter() - t0
     consistent = status != EMPTY
     if not consistent:
@@ -446,7 +516,8 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
     return Propagation(domains=doms, consistent=consistent, evaluations=evaluations,
                        iterations=evaluations / max(n, 1), time_s=elapsed, n_nodes=n,
                        n_slots=tape.n_slots, slots=Interval._new(lo, hi), mode=mode,
-                       shaving=shave_info, boxcons=bc_info, linear=lp_info)
+                       shaving=shave_info, boxcons=bc_info, linear=lp_info,
+                       centered=ctr_info)
 
 
 def _lp_rounds(tape: Tape, lo: np.ndarray, hi: np.ndarray, ptr: np.ndarray, adj: np.ndarray,
@@ -488,6 +559,63 @@ def _lp_rounds(tape: Tape, lo: np.ndarray, hi: np.ndarray, ptr: np.ndarray, adj:
             "settings": {"rounds": opts.rounds, "min_gain": opts.min_gain,
                          "radius": opts.radius, "log_linear": opts.log_linear,
                          "relax": opts.relax},
+            "time_s": time.perf_counter() - t0}
+    return status, info
+
+
+def _centered_rounds(tape: Tape, lo: np.ndarray, hi: np.ndarray, ptr: np.ndarray,
+                     adj: np.ndarray, families: tuple, rel_eps: float, window: int,
+                     targets: list[str] | None, opts: Centered) -> tuple[int, dict]:
+    """Window contraction of the centered form, then hull consistency on what it narrowed, in
+    place on ``lo``/``hi``, while a round pays. Returns the status and the counters."""
+    from ..ctc.windows import WINDOW_STATS, assign_targets, contract_windows
+    from ..expr.function_tape import constraint_functions
+
+    t0 = time.perf_counter()
+    assert tape.model is not None
+    ftape, _ = constraint_functions(tape.model)
+    vslots = np.array([tape.slot_of[v] for v in ftape.names], dtype=np.int64)
+    col = {v: j for j, v in enumerate(ftape.names)}
+    if targets is None:
+        tcols = np.arange(ftape.n_vars, dtype=np.int64)
+    else:
+        _shave_slots(tape, targets, "targets")  # the error for an unknown name
+        tcols = np.array([col[v] for v in targets if v in col], dtype=np.int64)
+    windows = assign_targets(ftape, tcols, opts.window, opts.stride or max(opts.window // 2, 1))
+    tslots = vslots[tcols]
+    prepare = time.perf_counter() - t0
+    counts = np.zeros(len(WINDOW_STATS), dtype=np.int64)
+    widths = [float(np.sum(hi[tslots] - lo[tslots]))]
+    status, evals, done = RUNNING, 0, 0
+    stats = np.zeros(1, dtype=np.int64)
+    while done < opts.rounds:
+        xl, xh = lo[vslots].copy(), hi[vslots].copy()
+        ok, st = contract_windows(ftape, xl, xh, windows)
+        counts += st
+        done += 1
+        if not ok:
+            status = EMPTY
+            break
+        nlo, nhi = lo.copy(), hi.copy()
+        np.maximum.at(nlo, vslots, xl)  # merged variables share a slot
+        np.minimum.at(nhi, vslots, xh)
+        w0, w1 = hi - lo, nhi - nlo
+        with np.errstate(invalid="ignore"):
+            sig = ((nlo != lo) | (nhi != hi)) & ((w0 == np.inf) | (w0 - w1 > rel_eps * w0))
+        lo[:], hi[:] = nlo, nhi
+        status = repropagate_kernel(tape.op, tape.out, tape.a, tape.b, tape.param, lo, hi, ptr,
+                                    adj, np.flatnonzero(sig).astype(np.int64), rel_eps, window,
+                                    stats, *families)
+        evals += int(stats[0])
+        if status == EMPTY:
+            break
+        widths.append(float(np.sum(hi[tslots] - lo[tslots])))
+        if not widths[-1] < (1.0 - opts.min_gain) * widths[-2]:
+            break
+    info = {"rounds": done, **{k: int(v) for k, v in zip(WINDOW_STATS, counts, strict=True)},
+            "evaluations": evals, "widths": widths, "prepare_s": prepare,
+            "settings": {"window": opts.window, "stride": opts.stride, "rounds": opts.rounds,
+                         "min_gain": opts.min_gain},
             "time_s": time.perf_counter() - t0}
     return status, info
 

@@ -1,9 +1,12 @@
 """Contractors: forward-backward on a tape, composition, fixpoint, inflation, q-relaxed
-intersection, 3B shaving; LP contraction of linear / log-linear sub-networks and of a linear
+intersection, 3B shaving; interval Jacobians, centered forms, the centered-form contractor and
+interval Newton; LP contraction of linear / log-linear sub-networks and of a linear
 relaxation of the nonlinear ones (polytope hull); the minimal polar contractor (range and
 bearing); the range sensor (first-hit distance along a ray of an obstacle map)."""
 
 from .base import Contractor, Fixpoint, FunctionContractor, Inflate, Sequence, Union, shrink_ratio
+from .centered import CtcCentered, CtcNewton
+from .derivatives import centered, jacobian
 from .fwdbwd import CtcFwdBwd
 from .linear import CtcLinear
 from .obstacles import ObstacleMap
@@ -13,6 +16,7 @@ from .raycast import CtcRayCast
 from .relax import CtcPolytopeHull
 from .shave import CtcShave
 
-__all__ = ["Contractor", "CtcFwdBwd", "CtcLinear", "CtcPolar", "CtcPolytopeHull", "CtcQInter",
-           "CtcRayCast", "CtcShave", "Fixpoint", "FunctionContractor", "Inflate", "ObstacleMap",
-           "Sequence", "Union", "shrink_ratio"]
+__all__ = ["Contractor", "CtcCentered", "CtcFwdBwd", "CtcLinear", "CtcNewton", "CtcPolar",
+           "CtcPolytopeHull", "CtcQInter", "CtcRayCast", "CtcShave", "Fixpoint",
+           "FunctionContractor", "Inflate", "ObstacleMap", "Sequence", "Union", "centered",
+           "jacobian", "shrink_ratio"]

@@ -5,13 +5,15 @@ systems, with proofs of existence and uniqueness).
 For constraints ``f(x) in Y`` on a box ``X`` with centre ``c``, every solution ``x`` satisfies
 ``f(c) + S (x - c) in Y`` for a real matrix ``S`` in the Jacobian enclosure ``J`` over ``X``
 (:mod:`boundest.ctc.derivatives`), so ``d = x - c`` lies in the solution set of the interval
-linear system ``J d in Y - f(c)``, which :func:`~boundest.ctc.linear_forms.contract_rows`
-projects outward. Without preconditioning this is the centered contractor of Codac 2's
-``CtcInverse``: each constraint on its own, with the first-order correlation of its variables
-kept. With Gauss-Jordan preconditioning (``P = mid(J)`` reduced, rows ``P J d in P (Y - f(c))``)
-the rows are nearly decoupled and the contraction is asymptotically minimal for narrow boxes
-(Jaulin 2023, arXiv 2307.10502): the result tends to the hull of the solution set, where hull
-consistency stays at the hull of each constraint's projection.
+linear system ``J d in (Y & f(X)) - f(c)``, which
+:func:`~boundest.ctc.linear_forms.contract_rows` projects outward. Without preconditioning each
+constraint is taken on its own, with the first-order correlation of its variables kept. With
+Gauss-Jordan preconditioning (``P = mid(J)`` reduced, rows ``P J d in P (Y - f(c))``, swept
+forward, backward and forward, then the plain rows: the centered step of Codac 2's
+``CtcInverse`` also preconditions) the rows are nearly decoupled and the contraction is
+asymptotically minimal for narrow boxes (Jaulin 2023, arXiv 2307.10502): the result tends to
+the hull of the solution set, where hull consistency stays at the hull of each constraint's
+projection.
 
 For a square system ``f(x) = t`` the preconditioned rows are the Hansen-Sengupta (Gauss-Seidel)
 step of interval Newton, and the Krawczyk operator
@@ -44,6 +46,7 @@ from .linear_forms import (
     preconditioner,
     square_preconditioner,
 )
+from .windows import WINDOW_STATS, batch_kernel
 
 __all__ = ["CtcCentered", "CtcNewton"]
 
@@ -113,7 +116,14 @@ def _centered_kernel(el, eh, row_ptr, cols, fcl, fch, vl, vh, tl, th, xl, xh, c,
             if np.any(np.isnan(fcl[bx])):
                 continue  # the centre is outside some primitive's domain: no linearisation
             jl, jh = _dense(el[bx], eh[bx], row_ptr, cols, n)
-            zl, zh = _rhs(tl[bx], th[bx], fcl[bx], fch[bx])
+            # f(x) lies in Y and in the natural form f(X): Y & f(X) - f(c) (as Codac 2 does)
+            m = tl.shape[1]
+            yl = np.empty(m)
+            yh = np.empty(m)
+            for k in range(m):
+                yl[k] = max(tl[bx, k], vl[bx, k]) if vl[bx, k] == vl[bx, k] else tl[bx, k]
+                yh[k] = min(th[bx, k], vh[bx, k]) if vh[bx, k] == vh[bx, k] else th[bx, k]
+            zl, zh = _rhs(yl, yh, fcl[bx], fch[bx])
             dl = np.empty(n)
             dh = np.empty(n)
             for j in range(n):
@@ -121,10 +131,21 @@ def _centered_kernel(el, eh, row_ptr, cols, fcl, fch, vl, vh, tl, th, xl, xh, c,
                 dh[j] = sub_up(xh[bx, j], c[bx, j])
             empty = not contract_rows(jl, jh, zl, zh, dl, dh)
             if not empty and precondition:
-                P, _ = preconditioner(_midpoints(jl, jh))
+                A = _midpoints(jl, jh)
+                for j in range(n):
+                    w = dh[j] - dl[j]
+                    A[:, j] *= w if math.isfinite(w) else 1e300
+                P, _ = preconditioner(A)
                 ml, mh = point_times(P, jl, jh)
                 rl, rh = point_times(P, zl.reshape(-1, 1), zh.reshape(-1, 1))
-                empty = not contract_rows(ml, mh, rl[:, 0], rh[:, 0], dl, dh)
+                # the preconditioned rows forward, backward and forward again (each sweep
+                # starts from what the previous one narrowed), then the plain rows
+                bl, bh = ml[::-1].copy(), mh[::-1].copy()
+                brl, brh = rl[::-1, 0].copy(), rh[::-1, 0].copy()
+                empty = not (contract_rows(ml, mh, rl[:, 0], rh[:, 0], dl, dh)
+                             and contract_rows(bl, bh, brl, brh, dl, dh)
+                             and contract_rows(ml, mh, rl[:, 0], rh[:, 0], dl, dh)
+                             and contract_rows(jl, jh, zl, zh, dl, dh))
         if empty:
             xl[bx, :] = np.nan
             xh[bx, :] = np.nan
@@ -141,11 +162,14 @@ class _Linearised(Contractor):
         self.tape = _as_tape(system)
         self.n = self.tape.n_vars
 
-    def _linearise(self, x: Interval):
+    def _linearise(self, x: Interval, with_defined: bool = False):
         box = x.reshape(-1, self.n)
         c = midpoint(box)
         c = np.where(np.isnan(c), 0.0, c)
-        values, entries, ok = jacobian_sparse(self.tape, box, with_defined=True)
+        if with_defined:  # only a proof needs it (Newton)
+            values, entries, ok = jacobian_sparse(self.tape, box, with_defined=True)
+        else:
+            (values, entries), ok = jacobian_sparse(self.tape, box), None
         fc = evaluate(self.tape, Interval(c, c))
         return box, c, values, entries, ok, fc
 
@@ -158,11 +182,15 @@ class CtcCentered(_Linearised):
     ----------
     system : Model, list of Constraint or FunctionTape
         The constraints (see :func:`boundest.expr.function_tape.constraint_functions`).
-    precondition : bool
-        After each constraint's linearisation on its own (what Codac 2's ``CtcInverse`` does,
-        all of it when False), also contract with the rows of ``P J`` with ``P`` from
-        Gauss-Jordan elimination on ``mid(J)`` (asymptotically minimal for narrow boxes and
-        ``m <= n``; ``O(m^2 (m + n))`` per box).
+    precondition : bool or {"gauss-jordan", "lp"}
+        After each constraint's linearisation on its own (all of it when False), also contract
+        with the rows of ``P J``: with True or
+        ``"gauss-jordan"``, ``P`` from Gauss-Jordan elimination on ``mid(J)`` with columns
+        scaled by the domains' widths (asymptotically minimal for narrow boxes, Jaulin 2023;
+        ``O(m^2 (m + n))`` per box); with ``"lp"``, for each variable and each of its bounds
+        the aggregation of the rows that a linear programme over the linearisation finds best
+        (:mod:`boundest.ctc.windows`: the hull of the linearised set up to the Jacobian's
+        width, two small dense simplexes per variable and box).
 
     Examples
     --------
@@ -173,9 +201,12 @@ class CtcCentered(_Linearised):
     Interval([[0.5, 0.5], [0.5, 0.5]])
     """
 
-    def __init__(self, system: FunctionTape | Model, precondition: bool = True) -> None:
+    def __init__(self, system: FunctionTape | Model, precondition: bool | str = True) -> None:
         super().__init__(system)
-        self.precondition = bool(precondition)
+        if precondition not in (True, False, "gauss-jordan", "lp"):
+            raise ValueError(f"precondition must be True, False, 'gauss-jordan' or 'lp', got "
+                             f"{precondition!r}")
+        self.precondition = precondition
 
     def contract(self, x: Interval, targets: Interval | None = None) -> Interval:
         """Contract boxes ``(..., n)``; ``targets`` (broadcast to ``(..., m)``) replaces the
@@ -190,9 +221,13 @@ class CtcCentered(_Linearised):
             shape = (*x.shape[:-1], t.n_outputs)
             tl = np.broadcast_to(targets.lo, shape).reshape(len(lo), -1)
             th = np.broadcast_to(targets.hi, shape).reshape(len(lo), -1)
+        tl, th = np.ascontiguousarray(tl), np.ascontiguousarray(th)
         _centered_kernel(entries.lo, entries.hi, t.row_ptr, t.cols, fc.lo, fc.hi, values.lo,
-                         values.hi, np.ascontiguousarray(tl), np.ascontiguousarray(th), lo, hi,
-                         c, self.precondition)
+                         values.hi, tl, th, lo, hi, c, self.precondition in (True, "gauss-jordan"))
+        if self.precondition == "lp":
+            stats = np.zeros(len(WINDOW_STATS), dtype=np.int64)
+            batch_kernel(entries.lo, entries.hi, t.row_ptr, t.cols, fc.lo, fc.hi, tl, th, lo,
+                         hi, c, 20 * (t.n_outputs + self.n) + 200, stats)
         return _empty_rows(Interval._new(lo.reshape(x.shape), hi.reshape(x.shape)))
 
 
@@ -281,7 +316,7 @@ class CtcNewton(_Linearised):
 
     def prove(self, x: Interval) -> tuple[Interval, NDArray[np.bool_]]:
         """Contracted boxes and, per box, whether it provably holds exactly one solution."""
-        box, c, _, entries, ok, fc = self._linearise(x)
+        box, c, _, entries, ok, fc = self._linearise(x, with_defined=True)
         lo, hi = box.lo.copy(), box.hi.copy()
         proved = np.zeros(len(lo), dtype=np.bool_)
         t = self.tape

@@ -26,12 +26,13 @@ chain of local constraints costs the same per constraint however long it is.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numba as nb
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..expr.function_tape import FunctionTape
+from ..expr.function_tape import FunctionTape, as_function_tape
 from ..interval import Interval, as_interval
 from ..interval import algebraic as al
 from ..interval import arith as ar
@@ -162,14 +163,15 @@ def _slopes_other(code, zl, zh, xl, xh, yl, yh, p, buf):
         ll, lh = _f_log(xl, xh, math.log(xl), math.log(xh))
         sbl, sbh = _mul(ll, lh, zl, zh)
         return sal, sah, sbl, sbh
-    if code == ATAN2:  # atan2(y, x) with y = a, x = b: (x, -y) / (x^2 + y^2)
-        # around the origin (no angle) or across the branch cut (x < 0, y = 0 from below)
-        if (yl <= 0.0 <= yh and xl <= 0.0 <= xh) or (xl < 0.0 and yl < 0.0 <= yh):
+    if code == ATAN2:  # atan2(y, x): y = a is (xl, xh) here, x = b is (yl, yh)
+        # d/dy = x / (x^2 + y^2), d/dx = -y / (x^2 + y^2); entire around the origin (no
+        # angle) or across the branch cut (x < 0, y = 0 from below)
+        if (xl <= 0.0 <= xh and yl <= 0.0 <= yh) or (yl < 0.0 and xl < 0.0 <= xh):
             return -INF, INF, -INF, INF
         rl = _add_lo(_sqr_lo(yl, yh), _sqr_hi(yl, yh), _sqr_lo(xl, xh), _sqr_hi(xl, xh))
         rh = _add_hi(_sqr_lo(yl, yh), _sqr_hi(yl, yh), _sqr_lo(xl, xh), _sqr_hi(xl, xh))
-        sal, sah = _div(xl, xh, rl, rh)
-        sbl, sbh = _div(-yh, -yl, rl, rh)
+        sal, sah = _div(yl, yh, rl, rh)
+        sbl, sbh = _div(-xh, -xl, rl, rh)
         return sal, sah, sbl, sbh
     return -INF, INF, -INF, INF
 
@@ -260,8 +262,8 @@ def defined(code, zl, zh, xl, xh, yl, yh, p):
         return p >= 0.0 or not xl <= 0.0 <= xh
     if code == POW:
         return xl > 0.0 or (xl >= 0.0 and yl > 0.0)
-    if code == ATAN2:
-        return not ((yl <= 0.0 <= yh and xl <= 0.0 <= xh) or (xl < 0.0 and yl < 0.0 <= yh))
+    if code == ATAN2:  # atan2(y, x) with y = a (xl, xh), x = b (yl, yh)
+        return not ((xl <= 0.0 <= xh and yl <= 0.0 <= yh) or (yl < 0.0 and xl < 0.0 <= xh))
     if code == TAN:
         return zl > -INF and zh < INF
     if code == SIGN:
@@ -372,9 +374,11 @@ def _args(tape: FunctionTape) -> tuple:
     return (tape.op, tape.out, tape.a, tape.b, tape.param)
 
 
-def evaluate(tape: FunctionTape, box: ArrayLike | Interval) -> Interval:
+def evaluate(tape: FunctionTape | Any, box: ArrayLike | Interval) -> Interval:
     """Natural interval extension of the tape's outputs over a box or a batch ``(..., n)``;
-    returns shape ``(..., m)``."""
+    returns shape ``(..., m)``. ``tape`` may also be an expression, a list of them, a model
+    or a list of constraints (``expr.function_tape.as_function_tape``)."""
+    tape = as_function_tape(tape)
     box = as_interval(box)
     lo, hi, batch = _slots(tape, box)
     forward_kernel(*_args(tape), lo, hi, *family_flags(tape.op))
@@ -388,6 +392,7 @@ def jacobian_sparse(tape: FunctionTape, box: ArrayLike | Interval, with_defined:
     pattern (row ``k`` holds columns ``tape.cols[tape.row_ptr[k]:tape.row_ptr[k + 1]]``); with
     ``with_defined`` also a boolean array ``(...)``: whether every primitive is defined and
     continuous on the box."""
+    tape = as_function_tape(tape)
     box = as_interval(box)
     lo, hi, batch = _slots(tape, box)
     nnz = len(tape.cols)
@@ -408,9 +413,13 @@ def _row_index(tape: FunctionTape) -> NDArray[np.int64]:
     return np.repeat(np.arange(tape.n_outputs), np.diff(tape.row_ptr))
 
 
-def jacobian(tape: FunctionTape, box: ArrayLike | Interval) -> tuple[Interval, Interval]:
+def jacobian(tape: FunctionTape | Any, box: ArrayLike | Interval) -> tuple[Interval, Interval]:
     """Natural values ``(..., m)`` and an enclosure of the Jacobian ``(..., m, n)`` over a box
     or a batch of boxes ``(..., n)``.
+
+    ``tape`` is a ``FunctionTape``, an expression or a list of them (columns: the variables in
+    order of first appearance; ``function_tape(..., names)`` fixes another order), or a model
+    or a list of constraints (the functions ``lhs - rhs``, columns ``Model.variable_names``).
 
     Every entry ``J[k, j]`` contains ``d f_k / d x_j`` at every point of the box where it
     exists (and, for non-smooth primitives, their generalized derivatives), so that
@@ -421,10 +430,11 @@ def jacobian(tape: FunctionTape, box: ArrayLike | Interval) -> tuple[Interval, I
     >>> from boundest.expr import Var
     >>> from boundest.expr.function_tape import function_tape
     >>> x, y = Var("x"), Var("y")
-    >>> _, J = jacobian(function_tape([x * y, x ** 2]), Interval([1, 2], [2, 3]))
+    >>> _, J = jacobian([x * y, x ** 2], Interval([1, 2], [2, 3]))
     >>> J.lo.tolist(), J.hi.tolist()
     ([[2.0, 1.0], [2.0, 0.0]], [[3.0, 2.0], [4.0, 0.0]])
     """
+    tape = as_function_tape(tape)
     values, entries = jacobian_sparse(tape, box)
     batch = values.shape[:-1]
     jl = np.zeros((*batch, tape.n_outputs, tape.n_vars))
@@ -435,21 +445,32 @@ def jacobian(tape: FunctionTape, box: ArrayLike | Interval) -> tuple[Interval, I
     return values, Interval._new(jl, jh)
 
 
-def centered(tape: FunctionTape, box: ArrayLike | Interval, center: ArrayLike | None = None
-             ) -> Interval:
+def centered(tape: FunctionTape | Any, box: ArrayLike | Interval,
+             center: ArrayLike | None = None) -> Interval:
     """Mean-value (centered) form of the outputs, intersected with the natural form.
 
     ``f(X) in f(c) + J(X) (X - c)`` with ``c`` the midpoint of the box (clamped into the box
     and finite where a bound is infinite) unless ``center`` is given; ``f(c)`` is evaluated
     rigorously as an interval. The centered form is quadratically close to the range as the
     box shrinks, the natural form only linearly; their intersection is never wider than either.
-    Returns shape ``(..., m)``.
+    Returns shape ``(..., m)``; ``tape`` as in :func:`jacobian`.
+
+    Examples
+    --------
+    >>> from boundest.expr import Var
+    >>> x = Var("x")
+    >>> box = Interval(0.4, 0.6)[None]
+    >>> natural, mean_value = evaluate(x * (1 - x), box), centered(x * (1 - x), box)
+    >>> round(float(natural.width()[0]), 3), round(float(mean_value.width()[0]), 3)
+    (0.2, 0.04)
     """
+    tape = as_function_tape(tape)
     box = as_interval(box)
     c = midpoint(box) if center is None else np.asarray(center, dtype=np.float64)
     if center is not None and not np.all(box.contains(c) | box.is_empty()):
         raise ValueError("the center must lie in the box")
     natural, entries = jacobian_sparse(tape, box)
+    c = np.where(box.is_empty(), 0.0, c)  # an empty component: any centre, the result is empty
     fc = evaluate(tape, Interval(c, c))
     dx = box - Interval(c, c)
     rows = _row_index(tape)
@@ -467,7 +488,8 @@ def centered(tape: FunctionTape, box: ArrayLike | Interval, center: ArrayLike | 
 def midpoint(box: Interval) -> NDArray[np.float64]:
     """A finite point of each box: the midpoint, 0 or a finite bound where one is infinite."""
     lo, hi = box.lo, box.hi
-    c = 0.5 * lo + 0.5 * hi
+    with np.errstate(invalid="ignore"):  # inf - inf where both bounds are infinite: replaced
+        c = 0.5 * lo + 0.5 * hi
     c = np.where(np.isfinite(lo) & np.isfinite(hi), c,
                  np.where(np.isfinite(lo), lo, np.where(np.isfinite(hi), hi, 0.0)))
     return np.clip(c, lo, hi)

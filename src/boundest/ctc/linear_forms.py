@@ -91,17 +91,28 @@ def _scale(p, lo, hi):
 @_njit
 def point_times(P, lo, hi):
     """``P [lo, hi]`` for a real ``P`` (m, k) and an interval matrix ``(k, n)`` rounded
-    outward; returns ``(lo, hi)`` of shape (m, n). An inf - inf sum is the entire line."""
+    outward; returns ``(lo, hi)`` of shape (m, n). An inf - inf sum is the entire line. Only
+    the nonzero entries of each row of the interval matrix are visited (Jacobians of local
+    constraints are sparse)."""
     m, k = P.shape
     n = lo.shape[1]
     rl = np.zeros((m, n))
     rh = np.zeros((m, n))
-    for i in range(m):
-        for q in range(k):
+    nz = np.empty(n, dtype=np.int64)
+    for q in range(k):
+        cnt = 0
+        for j in range(n):
+            if lo[q, j] != 0.0 or hi[q, j] != 0.0:
+                nz[cnt] = j
+                cnt += 1
+        if cnt == 0:
+            continue
+        for i in range(m):
             p = P[i, q]
             if p == 0.0:
                 continue
-            for j in range(n):
+            for t in range(cnt):
+                j = nz[t]
                 sl, sh = _scale(p, lo[q, j], hi[q, j])
                 rl[i, j] = add_dn(rl[i, j], sl)
                 rh[i, j] = add_up(rh[i, j], sh)

@@ -26,7 +26,7 @@ from .model import Model
 from .nodes import Const, Constraint, Expr, Var, as_expr, variables
 from .tape import _Builder
 
-__all__ = ["FunctionTape", "constraint_functions", "function_tape"]
+__all__ = ["FunctionTape", "as_function_tape", "constraint_functions", "function_tape"]
 
 
 @dataclass
@@ -112,7 +112,8 @@ def function_tape(outputs: Sequence[Expr | float], names: Sequence[str | Var] | 
         var_names = [v.name if isinstance(v, Var) else str(v) for v in names]
         if len(set(var_names)) != len(var_names):
             raise ValueError(f"a variable is listed twice in {var_names}")
-        missing = [v.name for v in variables(exprs) if v.name not in set(var_names)]
+        known = set(var_names)
+        missing = [v.name for v in variables(exprs) if v.name not in known]
         if missing:
             raise ValueError(f"the outputs use variables not among the given names: {missing}")
     if targets is None:
@@ -178,3 +179,26 @@ def constraint_functions(model: Model | Sequence[Constraint]) -> tuple[FunctionT
     lo = np.array([float(model.domains[v].lo) if v in model.domains else -np.inf for v in names])
     hi = np.array([float(model.domains[v].hi) if v in model.domains else np.inf for v in names])
     return tape, Interval(lo, hi)
+
+
+def as_function_tape(system: FunctionTape | Model | Expr | Sequence,
+                     names: Sequence[str | Var] | None = None) -> FunctionTape:
+    """A ``FunctionTape`` from what a user has at hand: a tape (returned as it is), a model or
+    a list of constraints (``constraint_functions``: ``g = lhs - rhs`` with their targets, the
+    model's variables), or an expression or a list of expressions (``function_tape``, columns
+    ``names`` or the variables in order of first appearance)."""
+    if isinstance(system, FunctionTape):
+        return system
+    if isinstance(system, Model):
+        return constraint_functions(system)[0]
+    if isinstance(system, Constraint):
+        return constraint_functions([system])[0]
+    if isinstance(system, (Expr, int, float)):
+        return function_tape([system], names)
+    items = list(system)
+    if items and all(isinstance(c, Constraint) for c in items):
+        return constraint_functions(items)[0]
+    if any(isinstance(c, Constraint) for c in items):
+        raise TypeError("mix of constraints and expressions: pass either constraints (a model) "
+                        "or expressions (functions)")
+    return function_tape(items, names)

@@ -17,7 +17,7 @@ nodes merge only when their argument slots are equal.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
@@ -49,6 +49,9 @@ class Tape:
         input was produced earlier (forward order).
     param : (n_nodes,) float64
         Integer exponent of ``pown`` nodes (0 elsewhere).
+    model : Model, optional
+        The model the tape was compiled from (``compile_model`` keeps it: the centered-form
+        modes of ``propagate`` differentiate its constraints).
     """
 
     lo: NDArray[np.float64]
@@ -59,6 +62,7 @@ class Tape:
     a: NDArray[np.int32]
     b: NDArray[np.int32]
     param: NDArray[np.float64]
+    model: Model | None = field(default=None, repr=False, compare=False)
 
     @property
     def n_slots(self) -> int:
@@ -191,7 +195,9 @@ def compile_model(model: Model | list[Constraint], domains: dict[str, Interval] 
                 bld.restrict(bld.expr(rhs), float(lhs.value.lo), np.inf)
             else:
                 bld.restrict(bld.expr(lhs - rhs), -np.inf, 0.0)
-    return _close(bld, merges)
+    tape = _close(bld, merges)
+    tape.model = model
+    return tape
 
 
 def _close(bld: _Builder, merges: list[tuple[int, int]]) -> Tape:

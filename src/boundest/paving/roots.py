@@ -13,7 +13,7 @@ solution of the system in the initial box lies in a proved or an undecided box.
 from __future__ import annotations
 
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -23,9 +23,14 @@ from numpy.typing import NDArray
 from ..csp.engine import EMPTY, SHAVE_STATS, shave_kernel
 from ..csp.propagate import slot_users
 from ..ctc.centered import CtcNewton
-from ..ctc.derivatives import jacobian_sparse
+from ..ctc.derivatives import evaluate, jacobian_sparse
 from ..ctc.revise import family_flags
-from ..expr.function_tape import FunctionTape, constraint_functions
+from ..expr.function_tape import (
+    FunctionTape,
+    _as_function,
+    constraint_functions,
+    function_tape,
+)
 from ..expr.model import Model
 from ..expr.tape import compile_model
 from ..interval import Interval
@@ -128,7 +133,8 @@ def _nonempty(x: Interval) -> NDArray[np.bool_]:
     return ~np.isnan(x.lo).any(axis=-1)
 
 
-def _contract(newton: CtcNewton, prop: _Shaving, x: Interval, rounds: int
+def _contract(newton: CtcNewton, prop: _Shaving, x: Interval, rounds: int,
+              in_model: Callable[[Interval], NDArray[np.bool_]]
               ) -> tuple[Interval, NDArray[np.bool_], int]:
     """Alternate propagation (hull consistency and shaving) and Newton on each box while it
     shrinks by 10 % (its widest component). Returns the boxes, which are proved to hold exactly
@@ -138,8 +144,12 @@ def _contract(newton: CtcNewton, prop: _Shaving, x: Interval, rounds: int
     (one exact value): there it gets the component from before, since the Krawczyk test has no
     room to prove anything in a zero radius (any box between the two holds every solution).
     A box that Newton halved in a round is not shaved in the next one (Newton converges on it:
-    shaving would cost much and add little). Proved boxes leave the rounds: they are polished
-    by Newton alone (:func:`_polish`)."""
+    shaving would cost much and add little). A proof counts where the whole box Newton returns
+    lies in the declared domains and satisfies the other constraints (``in_model``): its one
+    solution of the equations is then a solution of the model (propagation, which uses the
+    domains and the other constraints, may have cut the root away and left Newton a thin
+    component widened back). Proved boxes leave the rounds: they are polished by Newton alone
+    (:func:`_polish`)."""
     lo, hi = x.lo.copy(), x.hi.copy()
     proved = np.zeros(len(x), dtype=np.bool_)
     active = _nonempty(x)
@@ -163,7 +173,7 @@ def _contract(newton: CtcNewton, prop: _Shaving, x: Interval, rounds: int
             z, p = newton.prove(z0)
             calls += len(sel)
             zl[sel], zh[sel] = z.lo, z.hi
-            proved[idx[sel]] = p & _nonempty(z)
+            proved[idx[sel]] = p & _nonempty(z) & in_model(z)
             with np.errstate(invalid="ignore"):
                 shave[idx[sel]] = ~(z.width().max(axis=-1) < 0.5 * z0.width().max(axis=-1))
         lo[idx], hi[idx] = zl, zh
@@ -176,7 +186,8 @@ def _contract(newton: CtcNewton, prop: _Shaving, x: Interval, rounds: int
 
 def _polish(newton: CtcNewton, x: Interval, rounds: int = 4) -> tuple[Interval, int]:
     """Newton steps on proved boxes while they halve (a contraction of a proved box holds its
-    solution: nothing to prove again)."""
+    solution, and lies in the domains and the other constraints if the box did: nothing to
+    prove again)."""
     calls = 0
     for _ in range(rounds):
         if not len(x):
@@ -192,16 +203,18 @@ def _polish(newton: CtcNewton, x: Interval, rounds: int = 4) -> tuple[Interval, 
     return x, calls
 
 
-def _prove(newton: CtcNewton, x: Interval, rounds: int
+def _prove(newton: CtcNewton, x: Interval, rounds: int,
+           in_model: Callable[[Interval], NDArray[np.bool_]]
            ) -> tuple[Interval, NDArray[np.bool_], int]:
-    """Newton alone while a box shrinks by 10 %: the boxes and which are proved."""
+    """Newton alone while a box shrinks by 10 %: the boxes and which are proved (a proof
+    counts where the box lies in the model, as in :func:`_contract`)."""
     proved = np.zeros(len(x), dtype=np.bool_)
     calls = 0
     for _ in range(rounds):
         before = x.width().max(axis=-1)
         x, p = newton.prove(x)
         calls += len(x)
-        proved |= p & _nonempty(x)
+        proved |= p & _nonempty(x) & in_model(x)
         with np.errstate(invalid="ignore"):
             if not np.any(x.width().max(axis=-1) < 0.9 * before):
                 break
@@ -243,8 +256,26 @@ def _bisect(tape: FunctionTape, x: Interval, eps: float
     return Interval._new(np.concatenate([llo, rlo]), np.concatenate([lhi, rhi])), ok
 
 
-def _merge(newton: CtcNewton, boxes: Interval) -> tuple[Interval, int]:
-    """Proved boxes that overlap and whose hull is proved to hold one solution are one."""
+def _inside(model: Model, names: list[str], domains: Interval
+            ) -> Callable[[Interval], NDArray[np.bool_]]:
+    """Per box, whether every point of it lies in the declared domains and satisfies the
+    model's constraints other than its equations (natural interval form)."""
+    others = [_as_function(c) for c in model.constraints if c.rel != "=="]
+    tape = function_tape([g for g, _, _ in others], names, [(a, b) for _, a, b in others])
+
+    def inside(x: Interval) -> NDArray[np.bool_]:
+        ok = np.all((x.lo >= domains.lo) & (x.hi <= domains.hi), axis=-1)
+        if others:
+            v = evaluate(tape, x)
+            ok &= np.all((v.lo >= tape.target_lo) & (v.hi <= tape.target_hi), axis=-1)
+        return ok
+
+    return inside
+
+
+def _merge(newton: CtcNewton, boxes: Interval, eps: float) -> tuple[Interval, int]:
+    """Proved boxes that overlap and whose hull (or the hull inflated by a quarter of its
+    width, at least ``eps / 4``) is proved to hold one solution are one."""
     k = len(boxes)
     if k < 2:
         return boxes, 0
@@ -259,10 +290,23 @@ def _merge(newton: CtcNewton, boxes: Interval) -> tuple[Interval, int]:
         for j in np.nonzero(meets[i, i + 1:])[0] + i + 1:
             if not keep[j]:
                 continue
+            if np.all((lo[i] <= lo[j]) & (hi[j] <= hi[i])) or np.all(
+                    (lo[j] <= lo[i]) & (hi[i] <= hi[j])):
+                # nested (e.g. the same point twice, from a root on a bisection face): the
+                # inner box's solution is the outer one's only solution
+                lo[i], hi[i] = np.maximum(lo[i], lo[j]), np.minimum(hi[i], hi[j])
+                keep[j] = False
+                merged += 1
+                continue
             h = Interval(np.minimum(lo[i], lo[j]), np.maximum(hi[i], hi[j]))
             hb, p = newton.prove(h[None, :])
-            if p[0]:
-                lo[i], hi[i] = hb.lo[0], hb.hi[0]
+            if not p[0]:  # a hull a few ulps wide leaves Krawczyk no room beyond rounding
+                rad = np.maximum(h.width(), eps) * 0.25
+                hb, p = newton.prove(Interval(h.lo - rad, h.hi + rad)[None, :])
+            if p[0]:  # one solution in the hull: the same in both boxes, so in both
+                nl = np.maximum(np.maximum(lo[i], lo[j]), hb.lo[0])
+                nh = np.minimum(np.minimum(hi[i], hi[j]), hb.hi[0])
+                lo[i], hi[i] = (nl, nh) if np.all(nl <= nh) else (hb.lo[0], hb.hi[0])
                 keep[j] = False
                 merged += 1
     return Interval(lo[keep], hi[keep]), merged
@@ -315,6 +359,7 @@ def solve_square(system: Model | Sequence, box: Interval | None = None, *, eps: 
         raise ValueError(f"eps must be positive, got {eps}")
     newton = CtcNewton(tape)
     prop = _Shaving(model, list(tape.names), shave=shaving)
+    in_model = _inside(model, list(tape.names), domains)
     frontier = box[None, :]
     proved_boxes: list[Interval] = []
     undecided: list[Interval] = []
@@ -323,7 +368,7 @@ def solve_square(system: Model | Sequence, box: Interval | None = None, *, eps: 
     stopped = "eps"
     while len(frontier):
         processed += len(frontier)
-        x, proved, c = _contract(newton, prop, frontier, 8)
+        x, proved, c = _contract(newton, prop, frontier, 8, in_model)
         calls += c
         alive = _nonempty(x)
         proved_boxes.append(x[proved])
@@ -360,12 +405,12 @@ def solve_square(system: Model | Sequence, box: Interval | None = None, *, eps: 
     if len(und):
         rad = np.maximum(und.width(), eps) * 0.25
         infl = Interval(np.maximum(und.lo - rad, box.lo), np.minimum(und.hi + rad, box.hi))
-        ib, ip, c = _prove(newton, infl, 4)
+        ib, ip, c = _prove(newton, infl, 4, in_model)
         calls += c
         if ip.any():
             sol = _cat([sol, ib[ip]], n)
             covers = _cat([covers, infl[ip]], n)
-    sol, merged = _merge(newton, sol)
+    sol, merged = _merge(newton, sol, eps)
     why = np.concatenate(reasons) if reasons else np.empty(0, dtype="<U13")
     if len(und):  # an undecided box inside a proved one holds no other solution
         inside = np.zeros(len(und), dtype=np.bool_)

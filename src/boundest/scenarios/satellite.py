@@ -29,7 +29,7 @@ import numpy as np
 
 from ..csp import propagate
 from ..csp.beta import BetaResult, beta_tuning
-from ..csp.propagate import Shaving
+from ..csp.propagate import Centered, Shaving
 from ..expr import Model, VarFamily
 from ..expr.functions import sqrt
 from ..expr.tape import Tape, compile_model
@@ -37,9 +37,11 @@ from ..interval import Interval
 from ._data import check_index, embedded, read_csv
 
 __all__ = [
+    "CENTERED",
     "DELTA",
     "MODES",
     "SHAVING",
+    "SHAVING_CENTERED",
     "W_BOUND",
     "X0_TRUE",
     "Measurements",
@@ -60,11 +62,16 @@ X0_TRUE = (4.0, 0.5, -0.2, 0.5)
 #: Sign restrictions of Remark 2 on x(0).
 X0_DOMAINS = ((0.0, np.inf), (0.0, np.inf), (-np.inf, 0.0), (0.0, np.inf))
 #: The propagation modes of ``solve``, the default first: 3B shaving of the states after hull
-#: consistency, or hull consistency alone (about 45 times cheaper, 4 times wider in x1 at
-#: k_max = 200; benchmarks/README.md has the table).
-MODES = ("3b", "hc4")
+#: consistency, then the centered form of windows of steps; 3B shaving alone; or hull
+#: consistency alone (benchmarks/README.md has the table of widths and times).
+MODES = ("3b+centered", "3b", "hc4")
 #: Shaving settings of the ``3b`` mode (``boundest.csp.propagate.Shaving``).
 SHAVING = Shaving()
+#: Shaving settings of the ``3b+centered`` mode: one round of cheaper probes, since the
+#: centered form then narrows the boxes further
+SHAVING_CENTERED = Shaving(probe_evals=200, rounds=1)
+#: Centered-form settings of the ``3b+centered`` mode: windows of 6 steps (42 constraints)
+CENTERED = Centered(window=56, rounds=2)
 #: CSV columns and their kinds: an output bound may be infinite (an output not measured at k)
 _COLUMNS = {"k": "finite", **{f"y{i}_{s}": s for i in (1, 2, 3) for s in ("lo", "hi")}}
 
@@ -245,6 +252,7 @@ class SatelliteResult:
     beta: float = 1.0
     mode: str = "hc4"
     shaving: dict | None = None
+    centered: dict | None = None
 
     def to_json(self) -> dict:
         """The fields of ``boundest run satellite --json`` (floats may be infinite or NaN:
@@ -255,7 +263,7 @@ class SatelliteResult:
         return {"scenario": "satellite", "k_max": self.k_max, "consistent": self.consistent,
                 "iterations": self.iterations, "evaluations": self.evaluations,
                 "time_s": self.time_s, "beta": self.beta, "mode": self.mode,
-                "shaving": self.shaving or {},
+                "shaving": self.shaving or {}, "centered": self.centered or {},
                 "k": list(range(self.k_max + 2)), "x_lo": rows(self.x_lo),
                 "x_hi": rows(self.x_hi)}
 
@@ -279,25 +287,31 @@ def _state_names(K: int) -> list[list[str]]:
 def _result(tape: Tape, prop, K: int, beta: float) -> SatelliteResult:
     slots = np.array(_state_names(K), dtype=object)
     idx = np.vectorize(tape.slot_of.__getitem__)(slots).astype(np.intp)
-    shaving = ({"settings": vars(SHAVING).copy(), **prop.shaving} if prop.mode == "3b"
-               else None)
+    settings = SHAVING_CENTERED if prop.mode == "3b+centered" else SHAVING
+    shaving = ({"settings": vars(settings).copy(), **prop.shaving} if prop.shaving else None)
     return SatelliteResult(K, prop.consistent, prop.iterations, prop.evaluations, prop.time_s,
-                           prop.slots.lo[idx], prop.slots.hi[idx], beta, prop.mode, shaving)
+                           prop.slots.lo[idx], prop.slots.hi[idx], beta, prop.mode, shaving,
+                           prop.centered or None)
 
 
 def solve(meas: Measurements, rel_eps: float = 1e-3, progress: bool | None = None,
-          mode: str = "3b") -> SatelliteResult:
+          mode: str = "3b+centered") -> SatelliteResult:
     """Propagate the satellite CSP to its fixed point (``time_s``: propagation only).
 
-    ``mode="3b"`` (default) shaves the states ``x1..x4`` of every step, in time order, after
-    hull consistency (``SHAVING``); ``mode="hc4"`` is hull consistency alone.
+    ``mode="3b+centered"`` (default) shaves the states ``x1..x4`` of every step, in time
+    order, after hull consistency (``SHAVING_CENTERED``), then contracts them with the
+    centered form of windows of eight steps (``CENTERED``: the linearised constraints of a window
+    aggregated with optimal multipliers, which keeps what the measurements of the neighbouring
+    steps say together); ``mode="3b"`` shaves harder (``SHAVING``) and stops there;
+    ``mode="hc4"`` is hull consistency alone.
     """
     if mode not in MODES:
         raise ValueError(f"mode must be one of {', '.join(MODES)}, got {mode!r}")
     tape = compile_model(build_model(meas))
     names = [v for row in _state_names(meas.k_max) for v in row]
     prop = propagate(tape, rel_eps=rel_eps, progress=progress, mode=mode, shave=names,
-                     shaving=SHAVING)
+                     shaving=SHAVING_CENTERED if mode == "3b+centered" else SHAVING,
+                     targets=names, centered=CENTERED)
     return _result(tape, prop, meas.k_max, 1.0)
 
 
