@@ -4,8 +4,11 @@ Standard benchmarks of interval solvers, solved by ``boundest.paving.roots.solve
 consistency and the preconditioned Hansen-Sengupta step on each box of the frontier, the Krawczyk
 test for existence and uniqueness, bisection of what is left): per problem the number of proved
 solutions, undecided boxes (with why), boxes contracted and the median time over ``--repeat``
-warm runs in-process (a first run compiles the kernels; it is not timed). Problems (the ``ibex``
-ones are those of IBEX's ``benchs/solver`` folder, same equations and domains):
+warm runs in-process. A first call (at most 64 boxes) compiles or loads the kernels before them:
+its time is recorded as ``first_call_s``, so that a run with an empty Numba cache
+(``NUMBA_CACHE_DIR`` a new folder, ``BOUNDEST_KERNEL_ARCHIVE=0``) gives the compile cost on its
+first problem. Problems (the ``ibex`` ones are those of IBEX's ``benchs/solver`` folder, same
+equations and domains):
 
 - ``broyden-N`` (N = 10, 100, 1000): Broyden banded (More, Garbow, Hillstrom 1981, problem 31,
   ``ml = 5``, ``mu = 1``), ``f_i = x_i (2 + 5 x_i^2) + 1 - sum_{j in J_i} x_j (1 + x_j)``,
@@ -33,8 +36,9 @@ give distinct roots.
 
 ``--bch DIR`` writes each problem as an IBEX ``.bch`` file (the same equations, printed by
 boundest) and ``--ibex PATH`` runs that ``ibexsolve`` binary on them (``-e EPS -t
-IBEX_TIMEOUT``, same ``--repeat``), recording its version, solution / unknown / pending box
-counts, cells, its CPU time and the wall time of the process.
+IBEX_TIMEOUT``, same ``--repeat``, one run for ``n >= 1000``), recording its version, solution
+/ unknown / pending box counts (its ``--`` is 0), cells, its CPU time and the wall time of the
+process.
 
 Usage::
 
@@ -279,7 +283,9 @@ def _simplified_newton(p: Problem, x: list) -> list:
 
 def run(p: Problem, repeat: int, eps: float) -> dict:
     model, box, _ = model_of(p)
+    t = time.perf_counter()
     solve_square(model, box, eps=eps, max_boxes=64)  # warm-up: compiles (or loads) the kernels
+    first = time.perf_counter() - t
     times, res = [], None
     for _ in range(repeat):
         t = time.perf_counter()
@@ -292,7 +298,7 @@ def run(p: Problem, repeat: int, eps: float) -> dict:
            "undecided": int((~res.proved).sum()), "undecided_why": res.stats["undecided_why"],
            "processed": res.stats["processed"], "bisections": res.stats["bisections"],
            "merged": res.stats["merged"], "stopped": res.stats["stopped"],
-           "time_s": statistics.median(times), "times_s": times,
+           "time_s": statistics.median(times), "times_s": times, "first_call_s": first,
            "widest_proved_box": float(sol.width().max()) if len(sol) else None}
     row["check"] = check_roots(p, sol)
     print(f"{p.name:>14}: {row['proved']} proved, {row['undecided']} undecided "
@@ -317,18 +323,26 @@ def run_ibex(binary: str, p: Problem, repeat: int, eps: float, folder: Path, lim
         got = {k: re.search(rf"{k}[^:]*:\s*(\S+)", text) for k in
                ("solution boxes", "unknown boxes", "boundary boxes", "pending boxes",
                 "cpu time used", "number of cells")}
-        vals = {k: (m.group(1) if m else None) for k, m in got.items()}
+        vals = {k: (None if m is None else "0" if m.group(1) == "--" else m.group(1))
+                for k, m in got.items()}
         cpu.append(float(vals["cpu time used"].rstrip("s")) if vals["cpu time used"] else None)
         out.update({"solutions": vals["solution boxes"], "unknown": vals["unknown boxes"],
                     "boundary": vals["boundary boxes"], "pending": vals["pending boxes"],
-                    "cells": vals["number of cells"], "status": (
-                        "success" if "successful" in text else "time limit" if
-                        "time limit" in text else "other: " + text.strip()[-200:])})
+                    "cells": vals["number of cells"], "status": _ibex_status(text)})
     out["cpu_s"] = statistics.median([c for c in cpu if c is not None]) if any(cpu) else None
     out["wall_s"] = statistics.median(wall)
     print(f"{'ibex ' + p.name:>20}: {out['solutions']} solutions, {out['unknown']} unknown, "
           f"{out['cells']} cells, {out['cpu_s']} s cpu", file=sys.stderr, flush=True)
     return out
+
+
+def _ibex_status(text: str) -> str:
+    """ibexsolve's verdict, from its report."""
+    for key, status in (("successful", "success"), ("infeasible", "infeasible"),
+                        ("'unknown' status", "unknown boxes"), ("time limit", "time limit")):
+        if key in text:
+            return status
+    return "other: " + text.strip()[-200:]
 
 
 def main() -> None:
@@ -362,7 +376,7 @@ def main() -> None:
                                       text=True).stdout.strip()
     with tempfile.TemporaryDirectory() as tmp:
         for p in todo:
-            row = run(p, args.repeat if p.n < 1000 else 1, args.eps)
+            row = run(p, args.repeat, args.eps)
             if args.ibex:
                 row["ibex"] = run_ibex(args.ibex, p, args.repeat if p.n < 1000 else 1,
                                        args.eps, Path(tmp), args.ibex_timeout)
@@ -373,6 +387,8 @@ def main() -> None:
           "machine": {"cpu": cpu_model(), "cpus": os.cpu_count(), "numpy": np.__version__,
                       "numba": numba.__version__, "load_before": load_before,
                       "load_after": os.getloadavg()},
+          "kernel_cache": {v: os.environ.get(v) for v in ("NUMBA_CACHE_DIR",
+                                                           "BOUNDEST_KERNEL_ARCHIVE")},
           "ibex": ibex_version, "eps": args.eps, "repeat": args.repeat, "rows": rows,
           "summary": {r["problem"]: {"proved": r["proved"], "undecided": r["undecided"],
                                      "boxes": r["processed"], "time_s": r["time_s"],
