@@ -36,9 +36,10 @@ give distinct roots.
 
 ``--bch DIR`` writes each problem as an IBEX ``.bch`` file (the same equations, printed by
 boundest) and ``--ibex PATH`` runs that ``ibexsolve`` binary on them (``-e EPS -t
-IBEX_TIMEOUT``, same ``--repeat``, one run for ``n >= 1000``), recording its version, solution
-/ unknown / pending box counts (its ``--`` is 0), cells, its CPU time and the wall time of the
-process.
+IBEX_TIMEOUT``, same ``--repeat``, one run for ``n >= 1000``; killed after ``1.5 IBEX_TIMEOUT +
+30`` s wall, since ibexsolve checks its limit only between cells), recording its version,
+solution / unknown / pending box counts (its ``--`` is 0), cells, its CPU time and the wall time
+of the process.
 
 Usage::
 
@@ -318,7 +319,15 @@ def run_ibex(binary: str, p: Problem, repeat: int, eps: float, folder: Path, lim
     cpu, wall = [], []
     for _ in range(repeat):
         t = time.perf_counter()
-        text = subprocess.run(cmd, capture_output=True, text=True, timeout=10 * limit + 60).stdout
+        try:
+            text = subprocess.run(cmd, capture_output=True, text=True,
+                                  timeout=1.5 * limit + 30).stdout
+        except subprocess.TimeoutExpired:  # -t is checked between cells: one cell can outlast it
+            wall.append(time.perf_counter() - t)
+            out.update({"solutions": None, "unknown": None, "boundary": None, "pending": None,
+                        "cells": None, "status": f"killed after {wall[-1]:.0f} s wall"})
+            cpu.append(None)
+            continue
         wall.append(time.perf_counter() - t)
         got = {k: re.search(rf"{k}[^:]*:\s*(\S+)", text) for k in
                ("solution boxes", "unknown boxes", "boundary boxes", "pending boxes",
@@ -332,7 +341,8 @@ def run_ibex(binary: str, p: Problem, repeat: int, eps: float, folder: Path, lim
     out["cpu_s"] = statistics.median([c for c in cpu if c is not None]) if any(cpu) else None
     out["wall_s"] = statistics.median(wall)
     print(f"{'ibex ' + p.name:>20}: {out['solutions']} solutions, {out['unknown']} unknown, "
-          f"{out['cells']} cells, {out['cpu_s']} s cpu", file=sys.stderr, flush=True)
+          f"{out['cells']} cells, {out['cpu_s']} s cpu, {out['status']}", file=sys.stderr,
+          flush=True)
     return out
 
 
