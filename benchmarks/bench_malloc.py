@@ -3,8 +3,9 @@
 Each run is a fresh process that imports boundest, solves once (loading the kernels), then
 times ``--repeat`` warm solves, reading user and system CPU time (``os.times``) and the peak
 resident memory (``ru_maxrss``). ``default`` sets ``BOUNDEST_MALLOC=default`` (glibc's dynamic
-thresholds, as before); ``tuned`` is what ``import boundest`` does (trim threshold 256 MiB,
-mmap threshold 32 MiB). The two alternate, ``--rounds`` times each, so that both see the same
+thresholds); ``tuned`` is what the ``boundest`` command does for its process and what
+``boundest.keep_freed_memory()`` does for a library user (trim threshold 256 MiB, mmap
+threshold 32 MiB). The two alternate, ``--rounds`` times each, so that both see the same
 load of this shared machine; the table gives the medians over all warm solves.
 
 Usage::
@@ -29,7 +30,7 @@ from _machine import cpu_model, emit
 CHILD = r"""
 import json, os, resource, sys, time
 import boundest
-from boundest._malloc import keep_freed_memory
+boundest.keep_freed_memory()  # does nothing under BOUNDEST_MALLOC=default
 case, repeat = sys.argv[1], int(sys.argv[2])
 if case == "range_only":
     from boundest.scenarios import range_only as m

@@ -303,6 +303,9 @@ def main() -> None:
     p.add_argument("--quick", action="store_true", help="robot at dt = 0.01 only, 3 repeats")
     p.add_argument("--out", help="write the JSON document to this file")
     args = p.parse_args()
+    import boundest
+
+    boundest.keep_freed_memory()  # as the boundest command does for itself (boundest._malloc)
     args.codac_variants = [v for v in args.codac_variants.split(",") if v]
     dts = [0.01] if args.quick else [float(v) for v in args.dts.split(",")]
     if args.quick:

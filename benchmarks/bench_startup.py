@@ -44,7 +44,7 @@ from pathlib import Path
 
 from _machine import cpu_model, emit
 
-from boundest._kernels import COMMANDS  # name -> arguments: the commands the archive covers
+from boundest._kernels_build import COMMANDS  # name -> arguments: the commands the archive covers
 
 ROOT = Path(__file__).resolve().parents[1]
 TARGETS = {"readme_first_command_s": 90.0, "satellite_cold_s": 20.0, "other_cold_s": 30.0,

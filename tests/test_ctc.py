@@ -344,10 +344,12 @@ def test_fwdbwd_keeps_every_solution(scenario):
     assert_point_kept((per[0] | far)(box), box, p)
     assert_point_kept(Fixpoint(Sequence(*per), max_iter=30)(boxes)[0], box, p)
     # propagation to a fixed point on the primitive network
-    res = propagate(model, domains={n: box[i] for i, n in enumerate(NAMES)})
-    assert res.consistent
-    dom = Interval._new([float(res[n].lo) for n in NAMES], [float(res[n].hi) for n in NAMES])
-    assert_point_kept(dom, box, p)
+    # (hull consistency, and the default mode: shaving then the centered form)
+    for mode in ("hc4", None):
+        res = propagate(model, domains={n: box[i] for i, n in enumerate(NAMES)}, mode=mode)
+        assert res.consistent
+        dom = Interval._new([float(res[n].lo) for n in NAMES], [float(res[n].hi) for n in NAMES])
+        assert_point_kept(dom, box, p)
 
 
 @settings(max_examples=200, suppress_health_check=[HealthCheck.filter_too_much,
@@ -372,9 +374,9 @@ def test_equality_with_a_result_variable_keeps_the_solution(scenario, data):
         assert np.all(r.is_subset(box4))
     doms = {n: box4[i] for i, n in enumerate(names)}
     if data.draw(st.booleans()):  # the same through a compiled tape
-        res = propagate(compile_model(m), domains=doms)
+        res = propagate(compile_model(m), domains=doms, mode="hc4")
     else:
-        res = propagate(m, domains=doms)
+        res = propagate(m, domains=doms, mode="hc4")
     assert res.consistent
     for i, n in enumerate(NAMES):
         assert mp_in(mpmath.mpf(p[n]), float(res[n].lo), float(res[n].hi)), n
@@ -536,14 +538,14 @@ def test_fixpoint_with_an_unbounded_component():
 
 def test_propagate_converges_with_an_unbounded_component():
     res = propagate([y == 0.5 * z, z == 0.5 * y, u >= -1],
-                    domains={"y": Interval(0, 10), "z": Interval(0, 10)})
+                    domains={"y": Interval(0, 10), "z": Interval(0, 10)}, mode="hc4")
     assert res.consistent and float(res["y"].lo) == 0.0 and float(res["y"].hi) < 1e-300
     assert float(res["z"].hi) < 1e-300
     assert float(res["u"].lo) == -1.0 and float(res["u"].hi) == INF
 
 
 def test_propagate_revises_a_self_referencing_node_again():
-    res = propagate([x == Op("sqrt", (x,))], domains={"x": Interval(0, 10)})
+    res = propagate([x == Op("sqrt", (x,))], domains={"x": Interval(0, 10)}, mode="hc4")
     assert float(res["x"].hi) <= 1.01
 
 
@@ -628,7 +630,7 @@ def test_inconsistent_sum():
     m.declare("x", (0, 1))
     m.declare("y", (0, 1))
     m.add(x + y == 3)
-    res = propagate(m)
+    res = propagate(m, mode="hc4")
     assert res.consistent is False
     assert all(np.all(d.is_empty()) for d in res.domains.values())
     ctc = CtcFwdBwd(m, ["x", "y"])
@@ -652,7 +654,7 @@ def test_inconsistent_sum():
     [Op("abs", (x,)) + 1 == 0.5],
 ])
 def test_inconsistent_csps(cons):
-    res = propagate(cons)
+    res = propagate(cons, mode="hc4")
     assert res.consistent is False
     names = list(compile_model(cons).slot_of)
     r = CtcFwdBwd(cons, names)(Interval.entire((len(names),)))
@@ -660,7 +662,7 @@ def test_inconsistent_csps(cons):
 
 
 def test_propagate_with_an_empty_domain_is_inconsistent():
-    res = propagate([x + y == 1], domains={"x": Interval.empty()})
+    res = propagate([x + y == 1], domains={"x": Interval.empty()}, mode="hc4")
     assert res.consistent is False
 
 
@@ -670,7 +672,7 @@ def test_propagate_with_an_empty_domain_is_inconsistent():
 
 def test_propagation_result():
     cons = [x + y == 3, x - y == 1, x.in_((0, 10)), y.in_((0, 10))]
-    res = propagate(cons, rel_eps=0.0)
+    res = propagate(cons, rel_eps=0.0, mode="hc4")
     # the primitive network: add(x, y) = 3 and sub(x, y) = 1, as in the hand computation of
     # test_linear_pair_by_hand: the fixed point is [1, 3] x [0, 2]
     assert res.consistent and res.n_nodes == 2
@@ -678,13 +680,13 @@ def test_propagation_result():
     assert res.evaluations >= 2 and res.iterations == res.evaluations / 2
     assert res.time_s >= 0.0 and res.slots.shape == (res.n_slots,)
     # a one-revision budget stops after one node
-    one = propagate(cons, max_evaluations=1)
+    one = propagate(cons, max_evaluations=1, mode="hc4")
     assert one.evaluations == 1 and one.consistent
     # a compiled tape, and domains overriding the model's
     tape = compile_model(cons)
     # x in [1, 2]: add gives y = 3 - x = [1, 2]; sub gives x - y = 1, x = 1 + y = [2, 3] & [1, 2]
     # = 2 and y = x - 1 = 1: the solution
-    r2 = propagate(tape, domains={"x": Interval(1, 2)})
+    r2 = propagate(tape, domains={"x": Interval(1, 2)}, mode="hc4")
     assert same(r2["x"], Interval(2, 2)) and same(r2["y"], Interval(1, 1))
 
 
@@ -694,7 +696,7 @@ def test_beta_tuning_by_hand():
     tape = compile_model(cons)
 
     def contract(beta):
-        return propagate(tape, domains={"w": Interval(-beta, beta)})
+        return propagate(tape, domains={"w": Interval(-beta, beta)}, mode="hc4")
 
     r = beta_tuning(contract, beta_max=16.0, tol=1e-3)
     assert 1.5 - 1e-9 <= r.beta <= 1.5 * (1 + 1e-3) + 1e-9
@@ -747,7 +749,7 @@ def test_satellite_model_end_to_end():
     text, truth = satellite_text(k_max)
     model = parse_model(text, "satellite.txt")
     assert len(model.constraints) == 7 * k_max
-    res = propagate(model)
+    res = propagate(model, mode="hc4")
     assert res.consistent
     for name, v in truth.items():
         assert mp_in(v, float(res[name].lo), float(res[name].hi)), (name, res[name])
@@ -780,7 +782,7 @@ def survives(model: Model, point: dict[str, Fraction]) -> None:
     r = CtcFwdBwd(model, names)(box)
     for j, n in enumerate(names):
         assert contains(r[j], point[n]), (n, point[n], r[j])
-    res = propagate(model, rel_eps=0.0)
+    res = propagate(model, rel_eps=0.0, mode="hc4")
     assert res.consistent
     for n in names:
         assert contains(res[n], point[n]), (n, point[n], res[n])
@@ -948,15 +950,17 @@ def test_pow_2_in_a_model_file_keeps_negative_solutions():
     import boundest as bd
 
     for text in ("pow(x, 2) = 4", "x^2 = 4", "pow(x, 2.0) = 4", "x^2.0 = 4"):
-        res = propagate(parse_model(f"x in [-3, 10]; Constraints {text};"), rel_eps=0.0)
+        res = propagate(parse_model(f"x in [-3, 10]; Constraints {text};"), rel_eps=0.0,
+                        mode="hc4")
         assert res.consistent and float(res["x"].lo) == -2.0 and float(res["x"].hi) == 2.0
     for e in (bd.pow(x, 2), x**2, x**2.0, bd.pow(x, 2.0)):
         m = Model()
         m.declare("x", (-3, 10))
-        res = propagate(m.add(e == 4), rel_eps=0.0)
+        res = propagate(m.add(e == 4), rel_eps=0.0, mode="hc4")
         assert float(res["x"].lo) == -2.0 and float(res["x"].hi) == 2.0
     # a non-integer exponent is the real power: x >= 0
-    res = propagate(parse_model("x in [-3, 10]; Constraints pow(x, 0.5) = 2;"), rel_eps=0.0)
+    res = propagate(parse_model("x in [-3, 10]; Constraints pow(x, 0.5) = 2;"), rel_eps=0.0,
+                    mode="hc4")
     assert contains(res["x"], Fraction(4)) and float(res["x"].lo) >= 0.0
 
 

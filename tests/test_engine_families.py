@@ -58,6 +58,6 @@ def test_family_flags():
     ("y = pow(x, 2.5)", "x", 0.758)])
 def test_every_family_contracts(constraint, var, hi):
     m = parse_model(f"x in [0, 3], y in [0, 0.5]; Constraints {constraint};")
-    res = propagate(m, rel_eps=1e-9)
+    res = propagate(m, rel_eps=1e-9, mode="hc4")
     assert res.consistent and float(res[var].lo) == 0.0
     assert hi - 1e-3 < float(res[var].hi) < hi + 1e-3

@@ -175,7 +175,7 @@ def test_demo_with_an_empty_cache_compiles_nothing_when_the_archive_matches(tmp_
                BOUNDEST_COMPILE_LOG=str(tmp_path / "log.json"), MPLBACKEND="Agg")
     for var in (k.ENV_SWITCH, "NUMBA_CPU_NAME", "NUMBA_CPU_FEATURES"):
         env.pop(var, None)
-    out = subprocess.run([sys.executable, "-m", "boundest._kernels", "_run", "demo", "--out",
+    out = subprocess.run([sys.executable, "-m", "boundest._kernels_build", "_run", "demo", "--out",
                           str(tmp_path / "out")], env=env, capture_output=True, text=True,
                          timeout=600)
     assert out.returncode == 0, out.stderr[-2000:]

@@ -56,7 +56,7 @@ def _check(model, n, pts, res, hc):
 def test_solutions_survive_box_consistency_in_the_engine(csp, mode_kw):
     model, n, pts = csp
     mode, kw = mode_kw
-    hc = propagate(model)
+    hc = propagate(model, mode="hc4")
     res = propagate(model, mode=mode, **kw)
     _check(model, n, pts, res, hc)
     if res.boxcons:  # (a CSP whose equalities merge every node away has no phase to run)
@@ -69,7 +69,7 @@ def test_solutions_survive_box_consistency_in_the_engine(csp, mode_kw):
                                                                      log_linear=False)]))
 def test_solutions_survive_lp_in_the_engine(csp, opts):
     model, n, pts = csp
-    hc = propagate(model)
+    hc = propagate(model, mode="hc4")
     res = propagate(model, mode="lp", linear=opts)
     _check(model, n, pts, res, hc)
     if res.linear:
@@ -80,7 +80,7 @@ def test_box_consistency_narrows_what_hull_consistency_cannot():
     m = Model()
     m.declare(x, (-10.0, 10.0))
     m.add(x * x - x == 0)  # solutions 0 and 1; hull consistency keeps [-10, 10]
-    hc = propagate(m)
+    hc = propagate(m, mode="hc4")
     assert hc["x"].lo == -10.0 and hc["x"].hi == 10.0
     res = propagate(m, mode="bc", boxcons=BoxConsistency(depth=40, max_steps=400))
     assert res["x"].contains(0.0) and res["x"].contains(1.0)
@@ -97,7 +97,7 @@ def test_empty_csps_are_detected():
     m = Model()
     m.declare(x, (-10.0, 10.0))
     m.add(x * (x - 1) == -0.5)
-    assert propagate(m).consistent
+    assert propagate(m, mode="hc4").consistent
     for mode in ("bc", "bc+3b"):
         res = propagate(m, mode=mode)
         assert not res.consistent and all(bool(d.is_empty()) for d in res.domains.values())
@@ -107,7 +107,7 @@ def test_empty_csps_are_detected():
     for v in (x, y, z):
         m.declare(v, (-10.0, 10.0))
     m.add(x - y == 0, y - z == 0, (x - z).in_((1e-6, 2e-6)))
-    assert propagate(m).consistent
+    assert propagate(m, mode="hc4").consistent
     if HAS_SCIPY:
         res = propagate(m, mode="lp")
         assert not res.consistent and all(bool(d.is_empty()) for d in res.domains.values())
@@ -125,7 +125,7 @@ def test_lp_mode_narrows_what_hull_consistency_cannot_and_matches_propagate_lp()
     m.declare(x, (-1.0, 1.0))
     m.declare(y, (-1.0, 1.0))
     m.add(x + y == 0, x - y == 0)  # each alone holds on the whole box; together x = y = 0
-    assert propagate(m)["x"].lo == -1.0
+    assert propagate(m, mode="hc4")["x"].lo == -1.0
     res = propagate(m, mode="lp")
     ref = propagate_lp(m)
     for v in ("x", "y"):

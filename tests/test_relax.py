@@ -235,7 +235,7 @@ def test_relaxation_beats_hull_consistency_on_the_dependency_problem():
     """``x^2 - 2x + y = 0, y = x/2``: solutions x = 0 and x = 1.5; hull consistency cannot
     move x from [-3, 3] (x occurs twice), the polytope hull reaches [0, 1.5]."""
     m = _model_x_y([x * x - 2 * x + y == 0, y == 0.5 * x])
-    hc = propagate(m)
+    hc = propagate(m, mode="hc4")
     assert (float(hc["x"].lo), float(hc["x"].hi)) == (-3.0, 3.0)
     lp = propagate(m, mode="lp")  # the linear rows alone do not help either
     assert float(lp["x"].hi - lp["x"].lo) > 5.9
@@ -250,7 +250,7 @@ def test_relaxation_beats_hull_consistency_on_the_dependency_problem():
 def test_relax_option_of_ctc_linear_and_propagate_lp():
     m = _model_x_y([x * x - 2 * x + y == 0, y == 0.5 * x])
     tape = compile_model(m)
-    hc = propagate(tape)
+    hc = propagate(tape, mode="hc4")
     sx = tape.slot_of["x"]
     one = CtcLinear(tape, relax=True)(hc.slots)[sx]
     assert one.contains(0.0) and one.contains(1.5) and float(one.hi - one.lo) < 6.0
@@ -266,7 +266,7 @@ def test_relax_option_of_ctc_linear_and_propagate_lp():
 def test_polytope_hull_on_a_batch_and_on_an_empty_csp():
     m = _model_x_y([x * x - 2 * x + y == 0, y == 0.5 * x])
     tape = compile_model(m)
-    box = propagate(tape).slots
+    box = propagate(tape, mode="hc4").slots
     ctc = CtcPolytopeHull(tape, rounds=2)
     batch = ctc(Interval._new(np.stack([box.lo, box.lo]), np.stack([box.hi, box.hi])))
     one = ctc(box)
@@ -274,14 +274,15 @@ def test_polytope_hull_on_a_batch_and_on_an_empty_csp():
     assert np.array_equal(batch.lo[1], one.lo) and np.array_equal(batch.hi[0], one.hi)
     m = _model_x_y([x + y == 1.5, x * x + y * y <= 0.9], (-2.0, 2.0))
     tape = compile_model(m)
-    assert bool(CtcPolytopeHull(tape, rounds=10)(propagate(tape).slots).is_empty().all())
+    box = propagate(tape, mode="hc4").slots
+    assert bool(CtcPolytopeHull(tape, rounds=10)(box).is_empty().all())
     with pytest.raises(ValueError, match="rounds"):
         CtcPolytopeHull(tape, rounds=0)
 
 
 def test_relaxation_narrows_products_more_than_hull_consistency():
     m = _model_x_y([x * y == 1, x + y == 2.05], (0.0, 4.0))
-    hc = propagate(m)
+    hc = propagate(m, mode="hc4")
     r = propagate(m, mode="lp", linear=LinearRelaxation(relax=True, rounds=10))
     assert float(r["x"].hi - r["x"].lo) < float(hc["x"].hi - hc["x"].lo) - 1e-4
     assert r["x"].contains(0.8) and r["x"].contains(1.25)
@@ -297,7 +298,7 @@ def test_relax_is_off_by_default_and_proves_emptiness():
     # x^2 + y^2 = 1 and x + y = 1.5 meet; x + y = 1.5 with x^2 + y^2 <= 0.9 does not
     # (min of x^2 + y^2 on the line is 1.125), which hull consistency cannot see
     m = _model_x_y([x + y == 1.5, x * x + y * y <= 0.9], (-2.0, 2.0))
-    assert propagate(m).consistent
+    assert propagate(m, mode="hc4").consistent
     assert not propagate(m, mode="lp", linear=LinearRelaxation(relax=True, rounds=10)).consistent
 
 
@@ -317,7 +318,7 @@ def _survive(n, pts, doms):
 def test_solutions_survive_the_polytope_hull(csp):
     model, n, pts = csp
     tape = compile_model(model)
-    hc = propagate(tape)
+    hc = propagate(tape, mode="hc4")
     if not hc.consistent:
         raise AssertionError("hull consistency lost a known solution")
     box = CtcPolytopeHull(tape, rounds=3)(hc.slots)

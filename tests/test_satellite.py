@@ -33,7 +33,7 @@ def test_any_window_and_chunking_keeps_the_truth(window, chunk):
     """Windows of any size, and runs cut into chunks that stop inside a window, reach a sound
     fixed point: the simulated truth stays in every domain."""
     truth, meas = sat.simulate(40, seed=3)
-    res = propagate(sat.build_model(meas), window=window, chunk=chunk)
+    res = propagate(sat.build_model(meas), window=window, chunk=chunk, mode="hc4")
     assert res.consistent
     for k in range(41):
         for i in range(4):
@@ -113,7 +113,7 @@ def test_beta_tuning_on_consistent_data_goes_below_one():
 
 
 def test_model_text_file_gives_the_python_model_result():
-    text_res = propagate(load_model(embedded("satellite_k200.txt")))
+    text_res = propagate(load_model(embedded("satellite_k200.txt")), mode="hc4")
     py = sat.solve(sat.load(), mode="hc4")
     assert text_res.consistent
     for k in (0, 100, 201):
@@ -168,9 +168,12 @@ def test_cli_run_satellite_writes_json_and_figure(tmp_path, capsys):
 def test_cli_solve_prints_domains_and_flags_errors(tmp_path, capsys):
     m = tmp_path / "m.txt"
     m.write_text("x in [0, 10], y in [0, 10];\nConstraints\nx + y = 3, x - y = 1, x >= 1.5;\n")
-    assert main(["solve", str(m)]) == 0
+    assert main(["solve", str(m), "--mode", "hc4"]) == 0
     out = capsys.readouterr().out
     assert "consistent" in out and "x in [1.5, 2.5]" in out and "y in [0.5, 1.5]" in out
+    assert main(["solve", str(m)]) == 0  # the default mode solves the linear pair exactly
+    out = capsys.readouterr().out
+    assert "mode 3b+centered" in out and "x in [2, 2]" in out and "y in [1, 1]" in out
     m.write_text("x in [0, 1], y in [0, 1];\nConstraints\nx + y = 3;\n")
     assert main(["solve", str(m)]) == 1
     assert "INCONSISTENT" in capsys.readouterr().out

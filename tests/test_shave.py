@@ -31,7 +31,7 @@ def csps():
                                                    reach=1, min_gain=0.0)]))
 def test_solutions_survive_shaving_in_the_engine(csp, opts):
     model, n, pts = csp
-    hc = propagate(model)
+    hc = propagate(model, mode="hc4")
     res = propagate(model, mode="3b", shaving=opts)
     assert res.consistent and res.mode == "3b"
     for p in pts:
@@ -68,7 +68,7 @@ def _cross() -> Model:
 
 
 def test_shaving_finds_what_hull_consistency_cannot():
-    hc = propagate(_cross())
+    hc = propagate(_cross(), mode="hc4")
     assert hc["x"].lo == -1.0 and hc["x"].hi == 1.0
     res = propagate(_cross(), mode="3b", shaving=Shaving(rounds=20, min_gain=0.0))
     for v in ("x", "y"):
@@ -81,7 +81,7 @@ def test_shaving_finds_what_hull_consistency_cannot():
 def test_probes_that_refute_nothing_leave_no_trace():
     """A probe of one revision refutes no slice of the cross: every probe is undone, and the
     result is hull consistency's, bit for bit."""
-    hc = propagate(_cross())
+    hc = propagate(_cross(), mode="hc4")
     res = propagate(_cross(), mode="3b", shaving=Shaving(probe_evals=1, rounds=5, min_gain=0))
     assert res.shaving["probes"] > 0 and res.shaving["refuted"] == 0
     assert np.array_equal(res.slots.lo, hc.slots.lo) and np.array_equal(res.slots.hi,
@@ -113,7 +113,7 @@ def test_empty_unbounded_and_degenerate_domains():
     m.declare(x, (-1.0, 1.0))
     m.declare(y, (-1.0, 1.0))
     m.add(x + y == 0, x - y == 0, sqr(x) + sqr(y) >= 0.01)
-    assert propagate(m).consistent
+    assert propagate(m, mode="hc4").consistent
     res = propagate(m, mode="3b", shaving=Shaving(rounds=50, min_gain=0.0))
     assert not res.consistent
     assert all(bool(d.is_empty()) for d in res.domains.values())

@@ -156,7 +156,7 @@ def test_centered_modes_narrow_what_hull_consistency_cannot(tmp_path, capsys, mo
     f, js = tmp_path / "m.txt", tmp_path / "m.json"
     f.write_text("x in [0, 1], y in [0, 1];\nConstraints\nx + y + 0.1 * x * y = 1.1, "
                  "x - y = 0;\n")
-    assert main(["solve", str(f), "--json", str(tmp_path / "h.json")]) == 0
+    assert main(["solve", str(f), "--mode", "hc4", "--json", str(tmp_path / "h.json")]) == 0
     hc = json.loads((tmp_path / "h.json").read_text())["domains"]["x"]
     assert hc == [0.0, 1.0]
     assert main(["solve", str(f), "--mode", mode, "--json", str(js)]) == 0
@@ -168,3 +168,15 @@ def test_centered_modes_narrow_what_hull_consistency_cannot(tmp_path, capsys, mo
         a, c = mpmath.mpf("0.1"), mpmath.mpf("1.1")
         root = (-2 + mpmath.sqrt(4 + 4 * a * c)) / (2 * a)
         assert mpmath.mpf(x[0]) <= root <= mpmath.mpf(x[1]) and x[1] - x[0] < 1e-6
+
+
+def test_default_mode_is_3b_centered(tmp_path, capsys):
+    """With no --mode, solve runs the measured default (shaving, then the centered form), which
+    narrows the pair of constraints above to the root where hull consistency keeps [0, 1]."""
+    f = tmp_path / "m.txt"
+    f.write_text("x in [0, 1], y in [0, 1];\nConstraints\nx + y + 0.1 * x * y = 1.1, "
+                 "x - y = 0;\n")
+    assert main(["solve", str(f), "--json", str(tmp_path / "d.json")]) == 0
+    assert "mode 3b+centered:" in capsys.readouterr().out
+    x = json.loads((tmp_path / "d.json").read_text())["domains"]["x"]
+    assert 0.5356 < x[0] <= x[1] < 0.5357

@@ -7,7 +7,9 @@ functions that accept intervals and expressions alike (``sin(Interval)`` is an e
 ``from boundest import *``.
 
 The names are loaded on first access (PEP 562), so that ``import boundest.cli`` and
-``boundest --help`` load neither NumPy nor Numba.
+``boundest --help`` load neither NumPy nor Numba. Importing boundest changes no process-wide
+state; the ``boundest`` command tunes glibc's allocator for its own process, and
+``boundest.keep_freed_memory()`` does the same for a library user who asks (``_malloc``).
 """
 
 from __future__ import annotations
@@ -15,11 +17,7 @@ from __future__ import annotations
 import importlib
 from typing import Any
 
-from ._malloc import keep_freed_memory as _keep_freed_memory
-
 __version__ = "0.1.0"
-
-_keep_freed_memory()  # glibc: no page faults for re-allocated temporaries (see _malloc)
 
 #: name -> submodule that defines it (the interval names and the dispatching elementary
 #: functions are looked up in ``interval`` and ``expr.functions``, see ``__getattr__``)
@@ -39,6 +37,7 @@ _NAMES: dict[str, str] = {
                      "Tube", "TubeVector"), "tube"),
     **dict.fromkeys(("abs", "min", "max", "pow"), "expr.functions"),
     "Box": "interval",
+    "keep_freed_memory": "_malloc",
 }
 _ALIASES = {"Box": "IntervalVector", "centered_form": "centered"}
 _SUBPACKAGES = ("interval", "expr", "ctc", "csp", "paving", "tube", "estimation", "scenarios",

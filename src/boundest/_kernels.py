@@ -15,9 +15,11 @@ CPU name and features) accepts the entries. When anything does not match, or the
 read-only, it does nothing and kernels compile as before. ``BOUNDEST_KERNEL_ARCHIVE=0``
 disables it.
 
-``python -m boundest._kernels build`` rebuilds the archive (every command once with an empty
-cache, a few minutes), ``verify`` checks it (a fresh cache from the archive, every command,
-no compilation allowed), ``check`` says in one line whether it matches the sources.
+``python -m boundest._kernels check`` says in one line whether the archive matches the
+sources. Building and verifying it runs every command, so it lives in a module that the
+package never imports, :mod:`boundest._kernels_build` (``python -m boundest._kernels_build
+build | verify``): this module imports nothing of the package but ``_numba_cache``, so that
+``interval``, which activates the archive at import, stays the bottom layer.
 
 This is the only module that relies on Numba internals: the target-machine settings
 (``numba.config.CPU_NAME``/``CPU_FEATURES`` and ``numba.core.registry.cpu_target``), the
@@ -59,20 +61,6 @@ V3_FEATURES = frozenset({
 
 #: What the last :func:`activate` did ("installed", "in use", or why not), for messages.
 STATUS = "not checked"
-
-#: name -> arguments of ``boundest``: the commands whose kernels the archive holds
-COMMANDS: dict[str, list[str]] = {
-    "satellite": ["run", "satellite"],
-    "jaulin2001": ["run", "jaulin2001"],
-    "range-only": ["run", "range-only"],
-    "drifting-clock": ["run", "drifting-clock"],
-    "auv": ["run", "auv"],
-    "pool": ["run", "pool"],
-    "pool-online": ["run", "pool", "--online"],
-    "solve": ["solve", str(_PKG / "data" / "satellite_k200.txt")],
-    "demo": ["demo"],
-}
-
 
 # --- what the running process is ------------------------------------------------------------
 def running_versions() -> dict[str, str]:
@@ -137,7 +125,7 @@ def refusal(manifest: dict | None, versions: dict | None = None, digest: str | N
     digest = numba_sources_digest() if digest is None else digest
     if manifest["sources_sha256"] != digest:
         return ("stale: the Numba sources changed since it was built (rebuild: "
-                "python -m boundest._kernels build)")
+                "python -m boundest._kernels_build build)")
     if manifest["cpu_name"] != TARGET_CPU or manifest["cpu_features"] != TARGET_FEATURES:
         return f"built for CPU {manifest['cpu_name']!r}, this boundest uses {TARGET_CPU!r}"
     cpu_ok = host_supports_target() if cpu_ok is None else cpu_ok
@@ -304,214 +292,39 @@ def _activate() -> str:
     return "installed"
 
 
-# --- building and verifying (python -m boundest._kernels build | verify | check) -----------
-def _run_logged(argv: list[str], env: dict, log: Path, timeout: float) -> dict:
-    """``boundest ARGV`` in a new process that records every Numba compilation."""
-    import subprocess
-    import time
+def announce_compilation(what: str, estimate_s: float | None = None) -> None:
+    """Print one line on standard error when Numba first compiles a kernel in this process.
 
-    env = dict(env, BOUNDEST_COMPILE_LOG=str(log))
-    t0 = time.perf_counter()
-    p = subprocess.run([sys.executable, "-m", "boundest._kernels", "_run", *argv], env=env,
-                       capture_output=True, text=True, timeout=timeout, check=False)
-    wall = time.perf_counter() - t0
-    try:
-        rec = json.loads(log.read_text())
-    except (OSError, ValueError):
-        rec = {"compiled": None, "status": None}
-    return {"rc": p.returncode, "wall_s": round(wall, 1), **rec,
-            "stderr_tail": p.stderr[-1500:] if p.returncode not in (0, 1) else ""}
-
-
-def _command_argv(name: str, out: Path) -> list[str]:
-    argv = list(COMMANDS[name])
-    return argv if argv[0] == "solve" else [*argv, "--out", str(out)]
-
-
-def _logged_main(argv: list[str]) -> int:
-    """Run ``boundest ARGV``, writing the kernels Numba compiled to $BOUNDEST_COMPILE_LOG."""
+    Numba reports a compilation (a ``numba:compile`` event) only on a cache miss, so a run
+    that finds every kernel in the on-disk cache (compiled earlier, or unpacked from this
+    archive) prints nothing; a kernel the archive lacks is named as such, without the
+    estimate. Called by the command line before a command runs; ``what`` names the command,
+    ``estimate_s`` is its measured empty-cache compile time on 2 cores (printed as "about N s").
+    """
     from numba.core import event
 
-    compiled: list[str] = []
+    class _Notice(event.Listener):
+        def __init__(self) -> None:
+            self.said = False
 
-    class _Log(event.Listener):
-        def on_start(self, ev: event.Event) -> None:
-            d = (ev.data or {}).get("dispatcher")
-            f = getattr(d, "py_func", None) or getattr(d, "__wrapped__", None)
-            compiled.append(getattr(f, "__qualname__", None) or repr(d))
+        def on_start(self, ev: event.Event) -> None:  # noqa: ARG002 - numba's signature
+            if self.said:
+                return
+            self.said = True
+            if STATUS in ("installed", "in use"):  # the archive lacks this one
+                print(f"boundest: compiling a Numba kernel {what} uses that the shipped kernel "
+                      "archive lacks (once: it is cached on disk for later runs) ...",
+                      file=sys.stderr, flush=True)
+                return
+            how_long = (f"about {estimate_s:.0f} s on 2 cores" if estimate_s is not None
+                        else "it may take a minute")
+            print(f"boundest: compiling the Numba kernels {what} uses ({how_long}; once: they "
+                  f"are cached on disk for later runs) ...", file=sys.stderr, flush=True)
 
         def on_end(self, ev: event.Event) -> None:
             pass
 
-    event.register("numba:compile", _Log())
-    from .cli import main
-
-    try:
-        rc = _build_all_ufuncs() if argv == ["_ufuncs"] else main(argv)
-    finally:
-        status = getattr(sys.modules.get("boundest._kernels"), "STATUS", None)
-        Path(os.environ["BOUNDEST_COMPILE_LOG"]).write_text(json.dumps(
-            {"compiled": compiled, "status": status}))
-    return rc
-
-
-def _build_all_ufuncs() -> int:
-    """Compile every lazy (g)ufunc the package declares (interval elementary functions...)."""
-    import importlib
-    import pkgutil
-
-    import boundest
-
-    from .interval.rounding import _LazyGufunc, _LazyUfunc
-
-    for info in pkgutil.walk_packages(boundest.__path__, "boundest."):
-        if info.name.startswith(("boundest._kernels", "boundest.__main__")):
-            continue
-        try:
-            mod = importlib.import_module(info.name)
-        except Exception:  # optional extras (scipy, dask) may be missing
-            continue
-        for obj in list(vars(mod).values()):
-            if isinstance(obj, (_LazyGufunc, _LazyUfunc)) and obj._ufunc is None:
-                obj._build()
-    # a compiled contractor that no command runs (its kernel would compile on first use)
-    from .ctc import CtcPolar
-    from .interval import Interval
-
-    box = Interval([-10.0, -10.0, 1.9, 0.7], [10.0, 10.0, 2.1, 0.8])
-    CtcPolar()(box)
-    CtcPolar(center=(1.0, 2.0))(box)
-    from .interval.relaxed import qinter  # CtcQInter and RobustObserver; no command runs it
-
-    qinter(Interval([[0.0], [1.0]], [[2.0], [3.0]]), 1)
-    _build_engine_variants()
-    return 0
-
-
-#: one operator of each family of ``boundest.ctc.revise.FAMILIES``, in the model text format
-_FAMILY_TERMS = {"piecewise": "abs(x)", "pown": "x^3", "explog": "exp(y)", "trig": "sin(x)"}
-
-
-def _build_engine_variants() -> None:
-    """Compile the hull-consistency kernels for every combination of operator families.
-
-    ``propagate`` and ``CtcFwdBwd`` pass each family that a tape does not use as ``None``, so
-    that Numba prunes its branches: one specialisation per combination (16). The commands use
-    a few of them; with all of them in the archive a user's own model compiles nothing in
-    hull-consistency mode, whatever operators it has (the other modes compile on first use).
-    """
-    from itertools import combinations
-
-    from .csp import propagate
-    from .ctc import CtcFwdBwd
-    from .expr import parse_model
-    from .interval import Interval
-
-    names = list(_FAMILY_TERMS)
-    for r in range(len(names) + 1):
-        for chosen in combinations(names, r):
-            terms = " + ".join(["y", *(_FAMILY_TERMS[n] for n in chosen)])
-            model = parse_model(f"Variables x in [-1, 1], y in [-1, 1], z in [-9, 9];\n"
-                                f"Constraints z = {terms};")
-            propagate(model)
-            CtcFwdBwd(model, ["x", "y", "z"])(Interval([-1.0, -1.0, -9.0], [1.0, 1.0, 9.0]))
-
-
-def build(names: list[str] | None = None, timeout: float = 1800.0) -> int:
-    """Compile every command's kernels (or those of ``names``, for a quick try) into a new
-    cache and write the archive and manifest."""
-    import time
-
-    digest = numba_sources_digest()
-    t_start = time.perf_counter()
-    with tempfile.TemporaryDirectory(prefix="boundest-kernels-") as tmp:
-        cache = Path(tmp) / "cache"
-        env = dict(os.environ, NUMBA_CACHE_DIR=str(cache), NUMBA_CPU_NAME=TARGET_CPU,
-                   NUMBA_CPU_FEATURES=TARGET_FEATURES, MPLBACKEND="Agg")
-        env[ENV_SWITCH] = "0"
-        for name in [*(names or COMMANDS), "_ufuncs"]:
-            argv = ["_ufuncs"] if name == "_ufuncs" else _command_argv(name, Path(tmp) / "out")
-            r = _run_logged(argv, env, Path(tmp) / "log.json", timeout)
-            n = len(r["compiled"] or [])
-            print(f"build: {name:<15} {r['wall_s']:6.1f} s, {n} compilations, rc {r['rc']}",
-                  file=sys.stderr, flush=True)
-            if r["rc"] not in (0, 1):
-                print(r["stderr_tail"], file=sys.stderr)
-                return 1
-        files: dict[str, Path] = {}
-        sources: dict[str, str] = {}
-        for src_dir in sorted({p.parent for p in _PKG.rglob("*.py")}):
-            env_dir = _cache_folder_under(cache, src_dir)
-            rel = src_dir.relative_to(_PKG).as_posix()
-            mods = {p.stem for p in src_dir.glob("*.py")}
-            for f in sorted(env_dir.glob("*.nb[ic]")):
-                member = f"{rel}/{f.name}"
-                files[member] = f
-                mod = _module_of(f.name, mods)
-                if f.suffix == ".nbi" and mod:
-                    sources[member] = (src_dir / f"{mod}.py").relative_to(_PKG).as_posix()
-        if not files:
-            print("build: no cache files were written", file=sys.stderr)
-            return 1
-        tmp_archive = Path(tmp) / "kernels.tar.xz"
-        with tarfile.open(tmp_archive, "w:xz", preset=9) as tar:
-            for member, f in files.items():
-                info = tarfile.TarInfo(member)
-                data = f.read_bytes()
-                info.size, info.mtime, info.mode = len(data), 0, 0o644
-                tar.addfile(info, io.BytesIO(data))
-        raw = sum(f.stat().st_size for f in files.values())
-        packed = tmp_archive.read_bytes()
-    if numba_sources_digest() != digest:
-        print("build: the Numba sources changed while building (nothing written): build "
-              "again", file=sys.stderr)
-        return 1
-    manifest = {
-        **running_versions(), "cpu_name": TARGET_CPU, "cpu_features": TARGET_FEATURES,
-        "sources_sha256": digest, "archive_sha256": hashlib.sha256(packed).hexdigest(),
-        "archive_bytes": len(packed), "unpacked_bytes": raw,
-        "commands": list(names or COMMANDS), "files": list(files), "sources": sources}
-    _write_atomic(ARCHIVE, packed)
-    _write_atomic(MANIFEST, (json.dumps(manifest, indent=1) + "\n").encode())
-    print(f"build: {len(files)} files, {raw / 1e6:.1f} MB -> {ARCHIVE} "
-          f"{ARCHIVE.stat().st_size / 1e6:.1f} MB in {time.perf_counter() - t_start:.0f} s",
-          file=sys.stderr)
-    return 0
-
-
-def _cache_folder_under(cache: Path, src_dir: Path) -> Path:
-    sub = os.path.abspath(src_dir)
-    return cache / f"{os.path.basename(sub)}_{hashlib.sha1(sub.encode()).hexdigest()}"
-
-
-def _module_of(filename: str, modules: set[str]) -> str | None:
-    """The module a cache file belongs to: ``[prefix-]module.qualname-line.pyXY...``."""
-    head = filename.split(".", 1)[0]
-    if head in modules:
-        return head
-    if "-" in head and head.split("-", 1)[1] in modules:
-        return head.split("-", 1)[1]
-    return None
-
-
-def verify(names: list[str] | None = None, timeout: float = 900.0) -> int:
-    """Run every command (or ``names``) with a fresh cache from the archive; fail if anything
-    compiles."""
-    bad = 0
-    with tempfile.TemporaryDirectory(prefix="boundest-kernels-verify-") as tmp:
-        env = dict(os.environ, NUMBA_CACHE_DIR=str(Path(tmp) / "cache"), MPLBACKEND="Agg")
-        for var in (ENV_SWITCH, "NUMBA_CPU_NAME", "NUMBA_CPU_FEATURES"):
-            env.pop(var, None)
-        for name in names or COMMANDS:
-            r = _run_logged(_command_argv(name, Path(tmp) / "out"), env,
-                            Path(tmp) / "log.json", timeout)
-            ok = r["rc"] in (0, 1) and r["compiled"] == [] and r["status"] in ("installed",
-                                                                                "in use")
-            bad += not ok
-            print(f"verify: {name:<15} {r['wall_s']:6.1f} s, archive {r['status']}, "
-                  f"compiled {r['compiled']}, rc {r['rc']}: {'ok' if ok else 'FAILED'}",
-                  file=sys.stderr, flush=True)
-    return 1 if bad else 0
+    event.register("numba:compile", _Notice())
 
 
 def check() -> int:
@@ -523,16 +336,12 @@ def check() -> int:
 
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
-    if argv and argv[0] == "_run":
-        return _logged_main(argv[1:])
-    cmds = {"build": build, "verify": verify, "check": check}
-    names = argv[1:]
-    if not argv or argv[0] not in cmds or (names and argv[0] == "check") or any(
-            n not in COMMANDS for n in names):
-        print("usage: python -m boundest._kernels build | verify [COMMAND ...] | check\n"
-              f"commands: {' '.join(COMMANDS)}", file=sys.stderr)
+    if argv != ["check"]:
+        print("usage: python -m boundest._kernels check\n"
+              "(building and verifying the archive: python -m boundest._kernels_build "
+              "build | verify [COMMAND ...])", file=sys.stderr)
         return 2
-    return cmds[argv[0]](names) if names else cmds[argv[0]]()
+    return check()
 
 
 if __name__ == "__main__":

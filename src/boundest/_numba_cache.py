@@ -50,7 +50,7 @@ def kernels_marker() -> Path:
 
 #: Modules that mention Numba but define no kernel: editing them leaves every cached kernel
 #: valid (and the shipped kernel archive current).
-_NO_KERNELS = frozenset({"_numba_cache.py", "_kernels.py", "cli.py"})
+_NO_KERNELS = frozenset({"_numba_cache.py", "_kernels.py", "_kernels_build.py", "cli.py"})
 
 
 def numba_sources_digest() -> str:
@@ -81,43 +81,3 @@ def drop_stale_numba_cache() -> None:
         stamp.write_text(digest)
     except OSError:  # read-only install: Numba then caches elsewhere or not at all
         pass
-
-
-def announce_compilation(what: str, estimate_s: float | None = None) -> None:
-    """Print one line on standard error when Numba first compiles a kernel in this process.
-
-    Numba reports a compilation (a ``numba:compile`` event) only on a cache miss, so a run
-    that finds every kernel in the on-disk cache (compiled earlier, or unpacked from the
-    shipped kernel archive, ``_kernels``) prints nothing; a kernel the archive lacks is named
-    as such, without the estimate. Called by the command line
-    before a command runs; ``what`` names the command, ``estimate_s`` is its measured
-    empty-cache compile time on 2 cores (printed as "about N s").
-    """
-    import sys
-
-    from numba.core import event
-
-    class _Notice(event.Listener):
-        def __init__(self) -> None:
-            self.said = False
-
-        def on_start(self, ev: event.Event) -> None:  # noqa: ARG002 - numba's signature
-            if self.said:
-                return
-            self.said = True
-            from . import _kernels
-
-            if _kernels.STATUS in ("installed", "in use"):  # the archive lacks this one
-                print(f"boundest: compiling a Numba kernel {what} uses that the shipped kernel "
-                      "archive lacks (once: it is cached on disk for later runs) ...",
-                      file=sys.stderr, flush=True)
-                return
-            how_long = (f"about {estimate_s:.0f} s on 2 cores" if estimate_s is not None
-                        else "it may take a minute")
-            print(f"boundest: compiling the Numba kernels {what} uses ({how_long}; once: they "
-                  f"are cached on disk for later runs) ...", file=sys.stderr, flush=True)
-
-        def on_end(self, ev: event.Event) -> None:
-            pass
-
-    event.register("numba:compile", _Notice())

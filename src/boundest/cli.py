@@ -107,7 +107,10 @@ def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``boundest`` console script."""
     argv = sys.argv[1:] if argv is None else list(argv)
     args = build_parser(argv).parse_args(argv)
-    from ._numba_cache import announce_compilation
+    from ._kernels import announce_compilation
+    from ._malloc import keep_freed_memory
+
+    keep_freed_memory()  # the process is boundest's own: keep freed heap (see _malloc)
 
     what = args.scenario if args.command == "run" else args.command
     label = f"boundest run {what}" if args.command == "run" else f"boundest {what}"

@@ -295,12 +295,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--rel-eps", type=float, default=1e-3,
                    help="propagation stops when no domain shrinks by more than this fraction "
                         "of its width (default 1e-3)")
-    p.add_argument("--mode", choices=PROPAGATION_MODES, default="hc4",
-                   help="hull consistency alone (hc4, default), then box consistency (bc), "
-                        "3B shaving (3b), both (bc+3b), LP contraction (lp, needs the lp "
-                        "extra), the centered form of windows of constraints (centered) or "
-                        "shaving then the centered form (3b+centered); see "
-                        "boundest.csp.propagate and docs/derivatives.md")
+    p.add_argument("--mode", choices=PROPAGATION_MODES, default="3b+centered",
+                   help="shaving then the centered form of windows of constraints "
+                        "(3b+centered, default: the tightest), hull consistency alone (hc4: "
+                        "the fastest, 25-900 times cheaper), then box consistency (bc), 3B "
+                        "shaving (3b), both (bc+3b), LP contraction (lp, needs the lp extra) "
+                        "or the centered form alone (centered); see boundest.csp.propagate "
+                        "and docs/derivatives.md")
     p.add_argument("--all", action="store_true",
                    help="print every variable's domain instead of the summary")
     p.add_argument("--paving", type=float, metavar="EPS",

@@ -4,6 +4,7 @@ FALL/CLIMB on trees; beta-tuning."""
 from .beta import BetaResult, beta_tuning
 from .boxcons import CtcBox
 from .propagate import (
+    DEFAULT_MODE,
     MODES,
     BoxConsistency,
     Centered,
@@ -14,5 +15,5 @@ from .propagate import (
 )
 from .tree import Arc, TreeSCSP
 
-__all__ = ["MODES", "Arc", "BetaResult", "BoxConsistency", "Centered", "CtcBox", "LinearRelaxation",
-           "Propagation", "Shaving", "TreeSCSP", "beta_tuning", "propagate"]
+__all__ = ["DEFAULT_MODE", "MODES", "Arc", "BetaResult", "BoxConsistency", "Centered", "CtcBox",
+           "LinearRelaxation", "Propagation", "Shaving", "TreeSCSP", "beta_tuning", "propagate"]

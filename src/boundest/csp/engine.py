@@ -288,7 +288,8 @@ def shave_kernel(op, out, a, b, param, lo, hi, ptr, adj, cand, rel_eps, probe_ep
     its cost depends on how far its change travels, not on the length of the tape. Every
     contraction is either hull consistency or the removal of a slice proven empty: no solution
     is lost. ``stats`` receives the counters named in :data:`SHAVE_STATS`. Returns DONE, or
-    EMPTY when the network was proven to have no solution.
+    EMPTY when the network was proven to have no solution. (``ctc.CtcShave`` is the other
+    shaving, over any contractor and a batch of boxes; its module says why both exist.)
     """
     n = op.size
     nw = (n + window - 1) // window

@@ -91,8 +91,10 @@ def propagate_lp(model: Model | list[Constraint] | Tape, *, targets: list[str] |
         Also use a linear relaxation of the nonlinear nodes around the box of each round
         (``ctc.relax.relaxation``).
     **kwargs
-        Passed to ``propagate`` (``rel_eps``, ``max_evaluations``, ``window``, ...).
+        Passed to ``propagate`` (``rel_eps``, ``max_evaluations``, ``window``, ...); its
+        ``mode`` is ``"hc4"`` unless given.
     """
+    kwargs.setdefault("mode", "hc4")
     tape = model if isinstance(model, Tape) else compile_model(model)
     CtcLinear(tape)  # checks that SciPy is there before any work
     names = list(tape.slot_of) if targets is None else targets

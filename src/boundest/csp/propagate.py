@@ -1,8 +1,8 @@
 """Propagation of a CSP to a fixed point: hull consistency on its primitive decomposition
-(``mode="hc4"``), and on top of it box consistency (``"bc"``), 3B consistency by shaving
-(``"3b"``), both (``"bc+3b"``), LP contraction of the linear sub-networks (``"lp"``), or the
-centered form of windows of constraints with optimal multipliers (``"centered"``, and
-``"3b+centered"`` after shaving)."""
+(``mode="hc4"``, the fastest), and on top of it box consistency (``"bc"``), 3B consistency by
+shaving (``"3b"``), both (``"bc+3b"``), LP contraction of the linear sub-networks (``"lp"``), or
+the centered form of windows of constraints with optimal multipliers (``"centered"``, and
+``"3b+centered"`` after shaving, the default: :data:`DEFAULT_MODE`)."""
 
 from __future__ import annotations
 
@@ -28,13 +28,18 @@ from .engine import (
     shave_kernel,
 )
 
-__all__ = ["MODES", "BoxConsistency", "Centered", "LinearRelaxation", "Propagation",
+__all__ = ["DEFAULT_MODE", "MODES", "BoxConsistency", "Centered", "LinearRelaxation", "Propagation",
            "Shaving", "arg_users", "bc_candidates", "propagate", "slot_users"]
 
 #: The propagation modes: hull consistency alone, then box consistency, 3B shaving, box
 #: consistency and shaving, LP contraction, the centered form of windows of constraints, or
 #: shaving then the centered form (see ``propagate``).
 MODES = ("hc4", "bc", "3b", "bc+3b", "lp", "centered", "3b+centered")
+
+#: The mode ``propagate`` runs when none is given: chosen by measurement (benchmarks/README.md,
+#: "Which mode by default"), the only mode within 1.5x of the best widths on every problem
+#: measured, at 25-900 times the cost of ``"hc4"``, which stays one option away.
+DEFAULT_MODE = "3b+centered"
 
 
 @dataclass(frozen=True)
@@ -314,12 +319,17 @@ def bc_candidates(tape: Tape, slots: np.ndarray, max_nodes: int
 def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
               max_evaluations: int | None = None, domains: dict[str, Interval] | None = None,
               progress: bool | None = None, chunk: int = 2_000_000, window: int = 64,
-              mode: str = "hc4", shave: list[str] | None = None,
+              mode: str | None = None, shave: list[str] | None = None,
               shaving: Shaving | None = None, targets: list[str] | None = None,
               boxcons: BoxConsistency | None = None,
               linear: LinearRelaxation | None = None,
               centered: Centered | None = None) -> Propagation:
     """Contract all domains of a CSP to a fixed point.
+
+    The default mode is ``"3b+centered"`` (shaving, then the centered form): the tightest on
+    every model measured, at 25-900 times the cost of hull consistency alone (the record:
+    ``benchmarks/results/modes.json``). For a large model or a quick look, ``mode="hc4"``
+    costs one pass to the fixed point.
 
     ``mode="hc4"`` is hull consistency: every primitive node revised until nothing moves.
     ``mode="3b"`` then shaves (3B consistency, adaptive): for each variable of ``shave`` and
@@ -378,9 +388,11 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
         Consecutive tape nodes brought to their local fixed point together before a pass moves
         on (see ``engine.propagate_kernel``); 64 nodes is about three time steps of the
         satellite.
-    mode : {"hc4", "bc", "3b", "bc+3b", "lp", "centered", "3b+centered"}
+    mode : {"hc4", "bc", "3b", "bc+3b", "lp", "centered", "3b+centered"}, optional
         Hull consistency alone, or followed by box consistency, shaving, both, LPs, the
-        centered form, or shaving and the centered form.
+        centered form, or shaving and the centered form. Default :data:`DEFAULT_MODE`
+        (``"3b+centered"``), or ``"3b"`` for a ``Tape`` built without its model (by
+        ``expr.tape.instantiate``), which cannot be differentiated.
     shave : list of str, optional
         With ``mode="3b"``: the variables to shave, in the order they are visited (for a time
         series, by time step; default: every variable of the model in its order).
@@ -400,13 +412,15 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
     centered : Centered, optional
         With ``mode="centered"`` or ``"3b+centered"``: the settings (default ``Centered()``).
     """
-    if mode not in MODES:
+    if mode is not None and mode not in MODES:
         raise ValueError(f"mode must be one of {', '.join(MODES)}, got {mode!r}")
     if not 0.0 <= rel_eps < 1.0:
         raise ValueError(f"rel_eps must lie in [0, 1[, got {rel_eps}")
     if window < 1:
         raise ValueError(f"window must be a positive number of nodes, got {window}")
     tape = model if isinstance(model, Tape) else compile_model(model)
+    if mode is None:
+        mode = DEFAULT_MODE if tape.model is not None else "3b"
     if mode in ("centered", "3b+centered") and tape.model is None:
         raise ValueError(f"mode {mode!r} differentiates the model's constraints: pass the Model "
                          "(or a Tape from compile_model), not a Tape without its model")

@@ -6,6 +6,16 @@ back empty, it holds no solution and is removed (the next slice, twice as wide, 
 Every slice of every box of a batch is one call of ``ctc`` on the whole batch: there is no
 Python loop per box. It is the contractor form of ``propagate(mode="3b")``, which shaves a
 large CSP in the compiled engine (``boundest.csp``).
+
+Why two implementations of shaving. Neither calls the other, and neither can replace the
+other: this one shaves many boxes through an opaque contractor (any ``Contractor``: a
+``Fixpoint``, a polar or ray-cast contractor, a union, a Python function), each slice of every
+box one batched call, which a compiled kernel cannot take as an argument; the engine's
+``csp.engine.shave_kernel`` shaves one box of a CSP of thousands of variables through its tape,
+and its probes are local (they revise only what a slice reaches and undo themselves from a
+trail), so a probe costs what its change travels, not the size of the CSP, which no
+contractor-level loop can do. A contractor over a tape can have both: ``CtcShave(CtcFwdBwd(..))``
+here, or ``propagate(..., mode="3b")`` for one large box.
 """
 
 from __future__ import annotations

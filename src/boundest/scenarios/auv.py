@@ -227,7 +227,8 @@ class CtcDetections:
         mv = slice(per * nd, self.n_vars)
         m = Interval._new(lo[mv], hi[mv]) & mines.reshape(-1)
         lo[mv], hi[mv] = m.lo, m.hi
-        res = propagate(replace(self.tape, lo=lo, hi=hi), rel_eps=self.rel_eps, progress=False)
+        res = propagate(replace(self.tape, lo=lo, hi=hi), rel_eps=self.rel_eps, progress=False,
+                        mode="hc4")
         if not res.consistent:
             p.set_empty()
             for dom in (attitude, altitude, mines):

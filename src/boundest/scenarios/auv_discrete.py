@@ -145,7 +145,7 @@ def solve_discrete(data: AuvData, slam: bool = True, rel_eps: float = 1e-6,
     start = time.perf_counter()
     tape = discrete_tape(data, slam)
     build_s = time.perf_counter() - start
-    res = propagate(tape, rel_eps=rel_eps, progress=progress)
+    res = propagate(tape, rel_eps=rel_eps, progress=progress, mode="hc4")
     n = data.n
     s = res.slots
     pos = Interval._new(s.lo[: 3 * n].reshape(n, 3), s.hi[: 3 * n].reshape(n, 3))

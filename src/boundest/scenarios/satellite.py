@@ -335,7 +335,7 @@ def tune(meas: Measurements, beta_max: float = 16.0, tol: float = 1e-3, rel_eps:
         return replace(tape, lo=lo, hi=hi)
 
     t0 = time.perf_counter()
-    res = beta_tuning(lambda b: propagate(at(b), rel_eps=rel_eps),
+    res = beta_tuning(lambda b: propagate(at(b), rel_eps=rel_eps, mode="hc4"),
                       beta_max=beta_max, tol=tol)
     res.time_s = time.perf_counter() - t0
     return res, _result(tape, res.propagation, K, res.beta)
