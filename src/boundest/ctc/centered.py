@@ -45,7 +45,7 @@ from .linear_forms import (
     contract_rows,
     interval_elimination,
     point_times,
-    preconditioner,
+    square_preconditioner,
 )
 from .revise import family_flags, revise_nodes
 from .windows import WINDOW_STATS, batch_kernel
@@ -386,7 +386,7 @@ def _newton_kernel(el, eh, row_ptr, cols, fcl, fch, ok, tl, th, xl, xh, c, prove
             continue
         _dense(el[bx], eh[bx], row_ptr, cols, jl, jh)
         _midpoints(jl, jh, mid)
-        preconditioner(mid, W, pivot, used)
+        square_preconditioner(mid, W, pivot, used)  # sparse LU; Gauss-Jordan if singular
         full = True
         for r in range(n):
             if pivot[r] < 0:

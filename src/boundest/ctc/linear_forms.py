@@ -20,13 +20,14 @@ from __future__ import annotations
 import math
 
 import numba as nb
+import numpy as np
 
 from ..interval.algebraic import _mul_rev_all
 from ..interval.rounding import add_dn, add_up, mul_dn, mul_up
 from .revise import _div_hi, _div_lo, _sub_hi, _sub_lo
 
 __all__ = ["band_preconditioner", "contract_rows", "interval_elimination", "point_times",
-           "preconditioner"]
+           "preconditioner", "square_preconditioner"]
 
 _njit = nb.njit(cache=True, error_model="numpy")
 INF = math.inf
@@ -386,3 +387,109 @@ def _mdn(a, b):
 @nb.njit(cache=True, inline="always", error_model="numpy")
 def _mup(a, b):
     return 0.0 if (a == 0.0 or b == 0.0) else mul_up(a, b)
+
+
+@_njit
+def square_preconditioner(A, W, pivot, used):
+    """:func:`preconditioner`'s output (``P = W[:, n:]``, ``pivot``) for a square ``A``, by LU
+    with partial pivoting that skips zero entries: ``P ~ A^-1`` (``pivot[i] = i``), each row of
+    ``P`` without its entries below ``1e-20`` times its largest (the inverse of a banded matrix
+    decays away from the band), in about ``O(n nnz(L + U))`` where the full-pivoting
+    Gauss-Jordan elimination is ``O(n^3)`` (a banded Jacobian of 1000 unknowns: a few ms
+    against 0.7-2 s). A pivot below ``1e-13`` times the largest entry of ``A`` (singular or
+    nearly so) hands the matrix to :func:`preconditioner`, which copes with rank deficiency.
+    Any real ``P`` is sound; this one only decides how much the rows contract.
+    """
+    n = A.shape[0]
+    scale = 0.0
+    for i in range(n):
+        for j in range(n):
+            scale = max(scale, abs(A[i, j]))
+    if not scale > 0.0 or not math.isfinite(scale):
+        preconditioner(A, W, pivot, used)
+        return
+    LU = A.copy()
+    row = np.arange(n)  # row k of LU is row row[k] of A
+    last = np.zeros(n, dtype=np.int64)  # the last nonzero column of each row of LU
+    for i in range(n):
+        for j in range(n - 1, -1, -1):
+            if LU[i, j] != 0.0:
+                last[i] = j
+                break
+    for k in range(n):
+        p, best = k, abs(LU[k, k])
+        for i in range(k + 1, n):
+            if abs(LU[i, k]) > best:
+                p, best = i, abs(LU[i, k])
+        if not best > 1e-13 * scale:
+            preconditioner(A, W, pivot, used)
+            return
+        if p != k:
+            for j in range(n):
+                LU[k, j], LU[p, j] = LU[p, j], LU[k, j]
+            row[k], row[p] = row[p], row[k]
+            last[k], last[p] = last[p], last[k]
+        inv = 1.0 / LU[k, k]
+        for i in range(k + 1, n):
+            if LU[i, k] != 0.0:
+                f = LU[i, k] * inv
+                LU[i, k] = f
+                for j in range(k + 1, last[k] + 1):
+                    LU[i, j] -= f * LU[k, j]
+                last[i] = max(last[i], last[k])
+    # P = U^-1 L^-1 (rows permuted): forward then back substitution, one row of P at a time,
+    # each row kept within the span of its nonzero columns; an entry below 1e-20 times the
+    # largest of its row is dropped (the inverse of a banded matrix decays away from the band:
+    # what is dropped would only add subnormal arithmetic, and any real P is sound)
+    P = np.zeros((n, n))
+    c0 = np.empty(n, dtype=np.int64)
+    c1 = np.empty(n, dtype=np.int64)
+    for i in range(n):
+        P[i, row[i]] = 1.0
+        a, b = row[i], row[i]
+        for j in range(i):
+            f = LU[i, j]
+            if f != 0.0 and c0[j] <= c1[j]:
+                for c in range(c0[j], c1[j] + 1):
+                    P[i, c] -= f * P[j, c]
+                a, b = min(a, c0[j]), max(b, c1[j])
+        c0[i], c1[i] = _trim(P, i, a, b)
+    for i in range(n - 1, -1, -1):
+        a, b = c0[i], c1[i]
+        for j in range(i + 1, last[i] + 1):
+            f = LU[i, j]
+            if f != 0.0 and c0[j] <= c1[j]:
+                for c in range(c0[j], c1[j] + 1):
+                    P[i, c] -= f * P[j, c]
+                a, b = min(a, c0[j]), max(b, c1[j])
+        inv = 1.0 / LU[i, i]
+        for c in range(a, b + 1):
+            P[i, c] *= inv
+        c0[i], c1[i] = _trim(P, i, a, b)
+    for i in range(n):
+        for c in range(c0[i], c1[i] + 1):
+            if not math.isfinite(P[i, c]):
+                preconditioner(A, W, pivot, used)
+                return
+    for i in range(n):
+        pivot[i] = i
+        for j in range(n):
+            W[i, j] = 0.0  # (the reduced matrix is not needed: rows are in variable order)
+            W[i, n + j] = P[i, j]
+
+
+@_njit
+def _trim(P, i, a, b):
+    """Zero the entries of row ``i`` of ``P`` in columns ``a..b`` below ``1e-20`` times the
+    largest; returns the span of what is left (``a > b`` if nothing)."""
+    big = 0.0
+    for c in range(a, b + 1):
+        big = max(big, abs(P[i, c]))
+    cut = 1e-20 * big
+    lo, hi = b + 1, a - 1
+    for c in range(a, b + 1):
+        if abs(P[i, c]) < cut or P[i, c] == 0.0:
+            P[i, c] = 0.0
+        else:
+            lo, hi = min(lo, c), max(hi, c)
+    return lo, hi
