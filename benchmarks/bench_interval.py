@@ -637,7 +637,7 @@ def _run_case(case: Case, sizes: list[int], args: argparse.Namespace, env: dict)
                     row["boundest_ns"] = _r(_timeit(lambda fn=f, a=call_args: fn(*a), n,
                                                     args.repeat, args.min_sample))
                     if case.kind == "forward" and _accepts_out(f):
-                        out = interval._new(np.empty(n), np.empty(n))
+                        out = interval.trusted(np.empty(n), np.empty(n))
                         row["boundest_out_ns"] = _r(_timeit(
                             lambda fn=f, a=call_args, o=out: fn(*a, out=o), n, args.repeat,
                             args.min_sample))

@@ -145,7 +145,7 @@ def codac_side(box: Interval, ours: Interval, repeat: int) -> dict | str:
     m = box.shape[0]
     lo = np.array([[np.nan] * 4 if b is None else [c[0] for c in b] for b in res["bounds"]])
     hi = np.array([[np.nan] * 4 if b is None else [c[1] for c in b] for b in res["bounds"]])
-    theirs = Interval._new(lo, hi)
+    theirs = Interval.trusted(lo, hi)
     wo, wt = widths(ours), widths(theirs)
     return {"time_s": res["time_s"], "us_per_box": 1e6 * res["time_s"] / m, "boxes": m,
             "mean_width": dict(zip(NAMES, wt.mean(axis=0).tolist(), strict=True)),

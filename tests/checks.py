@@ -53,4 +53,4 @@ def engine_forward(name: str, x: Interval) -> Interval:
     for i in range(x.lo.size):
         lo[i], hi[i] = revise(code, -np.inf, np.inf, float(x.lo.flat[i]), float(x.hi.flat[i]),
                               0.0, 0.0, buf)[:2]
-    return Interval._new(lo, hi)
+    return Interval.trusted(lo, hi)

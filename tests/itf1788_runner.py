@@ -727,7 +727,7 @@ def _batch_args(vecs: Sequence[Vector]) -> list[Any]:
         if isinstance(first, Ival):
             lo = np.array([a.lo for a in col], dtype=np.float64)
             hi = np.array([a.hi for a in col], dtype=np.float64)
-            out.append(interval._new(lo, hi))
+            out.append(interval.trusted(lo, hi))
         elif isinstance(first, (bool, str)):
             raise TypeError(f"unsupported argument {first!r}")
         elif isinstance(first, int):

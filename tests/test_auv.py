@@ -105,7 +105,7 @@ def test_world_velocity_encloses_sampled_rotations():
 
 def test_inconsistent_fix_is_reported():
     data, _ = survey(0, 6000, 4, 3)
-    far = Interval._new(data.fix.lo.copy(), data.fix.hi.copy())
+    far = Interval.trusted(data.fix.lo.copy(), data.fix.hi.copy())
     far.lo[-1, 0] += 5000.0
     far.hi[-1, 0] += 5000.0
     bad = AuvData(**{**data.__dict__, "fix": far})

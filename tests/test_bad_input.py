@@ -283,13 +283,13 @@ def _strict(text: str) -> object:
 
 
 def test_the_json_convention():
-    data = {"a": Interval._new(np.array([0.0, -np.inf, np.nan]), np.array([1.0, 2.0, np.nan])),
+    data = {"a": Interval.trusted(np.array([0.0, -np.inf, np.nan]), np.array([1.0, 2.0, np.nan])),
             "b": Interval.empty(), "c": Interval.entire(), "d": np.array([np.nan, np.inf]),
             "e": (np.float64(-np.inf), np.int64(3), np.bool_(True))}
     assert _strict(dumps(data)) == {"a": [[0.0, 1.0], ["-inf", 2.0], None], "b": None,
                                     "c": ["-inf", "inf"], "d": [None, "inf"],
                                     "e": ["-inf", 3, True]}
-    assert jsonable(Interval._new(np.array([[0.0, np.nan]]), np.array([[1.0, np.nan]]))) == [
+    assert jsonable(Interval.trusted(np.array([[0.0, np.nan]]), np.array([[1.0, np.nan]]))) == [
         [[0.0, 1.0], None]]
 
 

@@ -40,7 +40,7 @@ def test_solutions_survive_box_consistency(csp, opts):
     # a batch: the full box, boxes around each solution point, an empty one
     rows_lo = [[-np.inf] * m] + [[v - 0.3 for v in p] + [-np.inf] * (m - n) for p in pts]
     rows_hi = [[np.inf] * m] + [[v + 0.3 for v in p] + [np.inf] * (m - n) for p in pts]
-    box = Interval._new(np.array([*rows_lo, [np.nan] * m]), np.array([*rows_hi, [np.nan] * m]))
+    box = Interval.trusted(np.array([*rows_lo, [np.nan] * m]), np.array([*rows_hi, [np.nan] * m]))
     for out in (ctc(box), ctc(hc(box)), Fixpoint(CtcBox(model, names) & hc)(box)):
         for p in pts:
             for r in range(len(pts) + 1):
@@ -104,7 +104,7 @@ def test_inputs_empty_unbounded_degenerate():
                    [-1e308, 0.0]])
     hi = np.array([[np.nan, np.nan], [np.inf, 0.0], [1.0, 0.0], [2.0, 0.0], [3.0, np.inf],
                    [1e308, 0.0]])
-    box = Interval._new(lo.copy(), hi.copy())
+    box = Interval.trusted(lo.copy(), hi.copy())
     out = ctc(box)
     assert np.array_equal(box.lo, lo, equal_nan=True)  # the input is not modified
     assert np.isnan(out.lo[0]).all()

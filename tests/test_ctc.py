@@ -348,7 +348,7 @@ def test_fwdbwd_keeps_every_solution(scenario):
     for mode in ("hc4", None):
         res = propagate(model, domains={n: box[i] for i, n in enumerate(NAMES)}, mode=mode)
         assert res.consistent
-        dom = Interval._new([float(res[n].lo) for n in NAMES], [float(res[n].hi) for n in NAMES])
+        dom = Interval.trusted([float(res[n].lo) for n in NAMES], [float(res[n].hi) for n in NAMES])
         assert_point_kept(dom, box, p)
 
 
@@ -579,11 +579,11 @@ def test_empty_boxes_stay_empty():
               FunctionContractor(lambda b: b, n=2)):
         assert np.all(c(empty).is_empty()), c
     # one empty component empties the whole box
-    part = Interval._new(np.array([0.0, np.nan]), np.array([10.0, np.nan]))
+    part = Interval.trusted(np.array([0.0, np.nan]), np.array([10.0, np.nan]))
     for c in (C_SUM, C_SUM | C_DIFF, C_SUM & C_DIFF, Inflate(C_SUM, 1.0)):
         assert np.all(c(part).is_empty()), c
     # in a batch, only the empty box
-    batch = Interval._new(np.array([[0.0, 0.0], [np.nan, 0.0]]),
+    batch = Interval.trusted(np.array([[0.0, 0.0], [np.nan, 0.0]]),
                           np.array([[10.0, 10.0], [np.nan, 10.0]]))
     r = C_SUM(batch)
     assert same(r[0], Interval([0, 0], [3, 3])) and np.all(r[1].is_empty())

@@ -97,7 +97,7 @@ def test_q_zero_and_q_n_minus_one_and_q_at_least_n():
     inter = parts[0]
     for c in parts[1:]:
         inter = inter & c
-    inter = Interval._new(np.where(np.isnan(inter.lo).any(-1, keepdims=True), np.nan, inter.lo),
+    inter = Interval.trusted(np.where(np.isnan(inter.lo).any(-1, keepdims=True), np.nan, inter.lo),
                           np.where(np.isnan(inter.lo).any(-1, keepdims=True), np.nan, inter.hi))
     assert np.all(CtcQInter(ctcs, 0)(boxes) == inter)  # the parallel intersection
     assert np.all(CtcQInter(ctcs, 3, "exact")(boxes) == Union(*ctcs)(boxes))
@@ -207,7 +207,8 @@ def test_qinter_boxes_is_what_ctcqinter_combines():
     ctcs, _ = rings(p, rng.uniform(-10, 10, (4, 2)), e=0.3, outliers={2})
     boxes = boxes_around(p, rng, 8)
     stacked = [c(boxes) for c in ctcs]
-    s = Interval._new(np.stack([b.lo for b in stacked], -2), np.stack([b.hi for b in stacked], -2))
+    s = Interval.trusted(np.stack([b.lo for b in stacked], -2),
+                         np.stack([b.hi for b in stacked], -2))
     expect = qinter_boxes(s, 1, "exact") & boxes
     got = CtcQInter(ctcs, 1, "exact")(boxes)
     bad = np.isnan(expect.lo).any(-1)

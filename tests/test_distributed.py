@@ -204,7 +204,7 @@ def _ring_image(x: Interval) -> Interval:
 
     s = x[:, 0] + x[:, 1]
     a, b = 3 * iv.sin(s), 3 * iv.cos(s)
-    return Interval._new(np.stack([a.lo, b.lo], 1), np.stack([a.hi, b.hi], 1))
+    return Interval.trusted(np.stack([a.lo, b.lo], 1), np.stack([a.hi, b.hi], 1))
 
 
 def test_image_on_cluster_is_the_in_process_image(client):

@@ -132,7 +132,7 @@ def test_cse_smooths_and_ends_like_ncse_on_boxes():
         for k in range(11):
             for h in hist:
                 hull = h.hull()
-                box = Interval._new(np.broadcast_to(hull.lo, (20, 11, 2))[i, k],
+                box = Interval.trusted(np.broadcast_to(hull.lo, (20, 11, 2))[i, k],
                                     np.broadcast_to(hull.hi, (20, 11, 2))[i, k])
                 assert exact_inside(r.x[k], box)
     # after the last measurement CSE holds the non-causal information (Theorem 7)

@@ -130,8 +130,8 @@ def test_cell_grid_certify_mark_and_cover():
     inside_known = Interval([[0.05, 0.05]], [[0.2, 0.2]])
     astride = Interval([[0.05, 0.05]], [[0.3, 0.2]])  # one unknown relevant cell
     far = Interval([[5.0, 5.0]], [[6.0, 6.0]])  # misses the target's hull
-    empty = Interval._new(np.full((1, 2), np.nan), np.full((1, 2), np.nan))
-    cov = g.covered(Interval._new(np.concatenate([b.lo for b in (inside_known, astride, far,
+    empty = Interval.trusted(np.full((1, 2), np.nan), np.full((1, 2), np.nan))
+    cov = g.covered(Interval.trusted(np.concatenate([b.lo for b in (inside_known, astride, far,
                                                                   empty)]),
                                   np.concatenate([b.hi for b in (inside_known, astride, far,
                                                                   empty)])))
@@ -169,7 +169,7 @@ def test_unique_rows_is_numpy_unique(seed, spread, m):
 
 
 def test_pave_and_image_with_extra_boxes():
-    y = Interval._new(np.array([[0.1, 0.1], [0.12, 0.1], [np.nan, np.nan]]),
+    y = Interval.trusted(np.array([[0.1, 0.1], [0.12, 0.1], [np.nan, np.nan]]),
                       np.array([[0.2, 0.15], [0.2, 0.15], [np.nan, np.nan]]))  # one empty
     sp = pave(y, 0.125)
     assert sp.stats == {"images": 2, "cells": 4} and not sp.inside.any()  # 2 x 2 cells, twice

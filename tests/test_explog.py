@@ -736,7 +736,7 @@ def batch(n: int = 400, seed: int = 0) -> Interval:
             a, b = [(-INF, b), (a, INF), (-INF, INF)][int(rng.integers(0, 3))]
         lo.append(min(a, b) if min(a, b) < INF else MAX)
         hi.append(max(a, b))
-    return Interval._new(np.array([*lo, math.nan]), np.array([*hi, math.nan]))
+    return Interval.trusted(np.array([*lo, math.nan]), np.array([*hi, math.nan]))
 
 
 def sample_points(xl: float, xh: float, rng: np.random.Generator) -> list[float]:
@@ -787,33 +787,33 @@ def test_unary_out_and_layouts(name):
         assert np.array_equal(r.lo.ravel(), ref.lo, equal_nan=True)
         assert np.array_equal(r.hi.ravel(), ref.hi, equal_nan=True)
 
-    out = Interval._new(np.empty(n), np.empty(n))
+    out = Interval.trusted(np.empty(n), np.empty(n))
     assert f(x, out=out) is out
     same_as_ref(out)
-    y = Interval._new(x.lo.copy(), x.hi.copy())
+    y = Interval.trusted(x.lo.copy(), x.hi.copy())
     f(y, out=y)  # in place
     same_as_ref(y)
-    y = Interval._new(x.lo.copy(), x.hi.copy())
-    f(y, out=Interval._new(y.hi, np.empty(n)))  # out.lo is the argument's upper bound
-    same_as_ref(Interval._new(y.hi, f(x).hi))
+    y = Interval.trusted(x.lo.copy(), x.hi.copy())
+    f(y, out=Interval.trusted(y.hi, np.empty(n)))  # out.lo is the argument's upper bound
+    same_as_ref(Interval.trusted(y.hi, f(x).hi))
     big = np.empty((4, n))
     big[0], big[2] = x.lo, x.hi
-    xs = Interval._new(big[0::2].T[:, 0], big[0::2].T[:, 1])  # strided views
+    xs = Interval.trusted(big[0::2].T[:, 0], big[0::2].T[:, 1])  # strided views
     same_as_ref(f(xs))
-    outs = Interval._new(np.empty(2 * n)[::2], np.empty(2 * n)[1::2])
+    outs = Interval.trusted(np.empty(2 * n)[::2], np.empty(2 * n)[1::2])
     f(xs, out=outs)
     same_as_ref(outs)
-    small = Interval._new(np.empty(10), np.empty(10))  # below _DIRECT_MIN: copied
+    small = Interval.trusted(np.empty(10), np.empty(10))  # below _DIRECT_MIN: copied
     f(x[:10], out=small)
     assert np.array_equal(small.lo, ref.lo[:10], equal_nan=True)
-    same_as_ref(f(Interval._new(x.lo.reshape(50, 100), x.hi.reshape(50, 100))), (50, 100))
-    xf = Interval._new(np.asfortranarray(x.lo.reshape(50, 100)),
+    same_as_ref(f(Interval.trusted(x.lo.reshape(50, 100), x.hi.reshape(50, 100))), (50, 100))
+    xf = Interval.trusted(np.asfortranarray(x.lo.reshape(50, 100)),
                        np.asfortranarray(x.hi.reshape(50, 100)))
     r = f(xf)
     assert np.array_equal(r.lo, ref.lo.reshape(50, 100), equal_nan=True)
     assert np.array_equal(r.hi, ref.hi.reshape(50, 100), equal_nan=True)
     # bounds of different shapes broadcast together: [0.5, 1], [0.5, 2]
-    r = f(Interval._new(np.array([0.5]), np.array([[1.0], [2.0]])))
+    r = f(Interval.trusted(np.array([0.5]), np.array([[1.0], [2.0]])))
     assert r.lo.shape == (2, 1)
     for j, h in enumerate((1.0, 2.0)):
         s = f(Interval(0.5, h))

@@ -97,3 +97,16 @@ def test_the_check_sees_an_upward_import(tmp_path):
     mods = {"boundest.interval.x": f, "boundest.cli": f, "boundest.interval": f}
     assert _imports("boundest.interval.x", f, mods) == {"boundest.cli", "boundest.interval"}
     assert _layer("boundest.cli") > _layer("boundest.interval.x")
+
+
+def test_outside_interval_trusted_bounds_use_the_public_constructor():
+    """``Interval._new`` is private to ``interval/``; the rest of the package says
+    ``Interval.trusted``."""
+    private = []
+    for f in sorted(PKG.rglob("*.py")):
+        if "interval" in f.relative_to(PKG).parts[:1]:
+            continue
+        for node in ast.walk(ast.parse(f.read_text())):
+            if isinstance(node, ast.Attribute) and node.attr == "_new":
+                private.append(f"{f.relative_to(PKG)}:{node.lineno}")
+    assert private == []

@@ -245,7 +245,7 @@ def test_centered_contractors_on_empty_and_unbounded_boxes():
     """An empty box stays empty, an unbounded one holding the solution keeps it; batched."""
     x, y = Var("x"), Var("y")
     model = Model().add(x * y == 2.0, x + y == 3.0)  # (1, 2) and (2, 1)
-    boxes = Interval._new(np.array([[np.nan, 0.0], [-INF, -INF], [0.0, 1.5], [1.5, 0.0]]),
+    boxes = Interval.trusted(np.array([[np.nan, 0.0], [-INF, -INF], [0.0, 1.5], [1.5, 0.0]]),
                           np.array([[np.nan, 1.0], [INF, INF], [INF, INF], [INF, 1.5]]))
     for ctc in (CtcCentered(model), CtcCentered(model, precondition=False),
                 CtcCentered(model, hc4=True), CtcNewton(model)):

@@ -95,7 +95,7 @@ def test_ring_f_y_sound_and_volumes_bracket_three_pi():
 
 def test_ring_outside_inside_boundary_tile_the_box():
     sp = sivia(SQUARE, f=X**2 + Y**2, y=Interval([1], [4]), eps=0.1, keep_outside=True)
-    every = Subpaving(Interval._new(np.concatenate([sp.boxes.lo, sp.outside.lo]),
+    every = Subpaving(Interval.trusted(np.concatenate([sp.boxes.lo, sp.outside.lo]),
                                     np.concatenate([sp.boxes.hi, sp.outside.hi])),
                       np.zeros(len(sp) + sp.outside.shape[0], dtype=bool))
     pts = np.random.default_rng(2).uniform(-3, 3, size=(5000, 2))
@@ -215,7 +215,7 @@ def test_box_difference(n, seed):
     t = np.sort(rng.uniform(0, 1, (b, n, 2)), axis=2)
     cl, ch = xl + t[..., 0] * (xh - xl), xl + t[..., 1] * (xh - xl)
     cl[rng.random(b) < 0.2] = np.nan  # some c empty
-    pieces, parent = box_difference(Interval._new(xl, xh), Interval._new(cl, ch))
+    pieces, parent = box_difference(Interval.trusted(xl, xh), Interval.trusted(cl, ch))
     assert np.all(np.bincount(parent, minlength=b) <= 2 * n)
     assert np.all(pieces.lo >= xl[parent]) and np.all(pieces.hi <= xh[parent])
     pts = xl[:, None, :] + rng.random((b, 50, n)) * (xh - xl)[:, None, :]
@@ -236,7 +236,7 @@ def _grid(rng: np.random.Generator, k: int, lo: float, step: float, keep: float)
     idx = np.stack([i.ravel(), j.ravel()], axis=1)
     idx = idx[rng.random(len(idx)) < keep]
     blo = lo + idx * step
-    return Subpaving(Interval._new(blo, blo + step), rng.random(len(idx)) < 0.5)
+    return Subpaving(Interval.trusted(blo, blo + step), rng.random(len(idx)) < 0.5)
 
 
 @settings(max_examples=40)
@@ -267,7 +267,7 @@ def test_subpaving_ops_against_membership(seed):
         h = a.hull()
         assert np.all(h.lo <= a.boxes.lo) and np.all(a.boxes.hi <= h.hi)
     # classify: boxes inside an inside box, meeting nothing, or in between
-    cls = a.classify(Interval._new(pts, pts))
+    cls = a.classify(Interval.trusted(pts, pts))
     assert np.array_equal(cls, np.where(ca == 1, 1, np.where(ca == -1, -1, 0)))
 
 
@@ -285,7 +285,7 @@ def test_subpaving_errors():
     with pytest.raises(ValueError, match="inside"):
         Subpaving(Interval([[0, 0]], [[1, 1]]), [True, False])
     with pytest.raises(ValueError, match="empty or invalid"):
-        Subpaving(Interval._new(np.array([[0.0, np.nan]]), np.array([[1.0, np.nan]])), [True])
+        Subpaving(Interval.trusted(np.array([[0.0, np.nan]]), np.array([[1.0, np.nan]])), [True])
     e = Subpaving.empty(2)
     assert e.is_empty() and e.volume_inner() == 0.0 == e.volume_outer()
     assert np.all(e.hull().is_empty()) and len(e.intersect(a)) == 0 and len(e.union(a)) == 1
@@ -293,7 +293,7 @@ def test_subpaving_errors():
 
 def test_volume_rounding_is_directed():
     third = 1 / 3  # widths that are not exact products
-    boxes = Interval._new(np.zeros((1000, 3)), np.full((1000, 3), third))
+    boxes = Interval.trusted(np.zeros((1000, 3)), np.full((1000, 3), third))
     sp = Subpaving(boxes, np.ones(1000, dtype=bool))
     exact = 1000 * Fraction(third) ** 3
     assert Fraction(sp.volume_inner()) <= exact <= Fraction(sp.volume_outer())
@@ -304,7 +304,7 @@ def test_volume_rounding_is_directed():
 def _f_seed(x: Interval) -> Interval:
     s = x[:, 0] + x[:, 1]
     a, b = 3 * iv.sin(s), 3 * iv.cos(s)
-    return Interval._new(np.stack([a.lo, b.lo], axis=1), np.stack([a.hi, b.hi], axis=1))
+    return Interval.trusted(np.stack([a.lo, b.lo], axis=1), np.stack([a.hi, b.hi], axis=1))
 
 
 def _covered(sp: Subpaving, exact: list[tuple[mpmath.mpf, ...]]) -> bool:

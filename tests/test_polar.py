@@ -239,7 +239,7 @@ def test_result_is_the_hull_of_the_solutions(bounds):
 # -------------------------------------------------------------------------------------------
 
 def _inflated(b: Interval, rel: float = 1e-12) -> Interval:
-    return Interval._new(b.lo - rel * (np.abs(b.lo) + 1.0), b.hi + rel * (np.abs(b.hi) + 1.0))
+    return Interval.trusted(b.lo - rel * (np.abs(b.lo) + 1.0), b.hi + rel * (np.abs(b.hi) + 1.0))
 
 
 @settings(max_examples=150, deadline=None)
@@ -273,7 +273,7 @@ def test_strictly_tighter_than_hull_consistency():
 # -------------------------------------------------------------------------------------------
 
 def test_empty_in_empty_out():
-    e = Interval._new(np.array([np.nan, 0.0, 0.0, 0.0]), np.array([np.nan, 1.0, 1.0, 1.0]))
+    e = Interval.trusted(np.array([np.nan, 0.0, 0.0, 0.0]), np.array([np.nan, 1.0, 1.0, 1.0]))
     assert CTC(e).is_empty().all()
     assert CTC(Interval.empty(4)).is_empty().all()
 

@@ -48,7 +48,7 @@ def box_sets(draw, max_n_members: int = 5, max_dim: int = 3):
     dim = draw(st.integers(1, max_dim))
     lo, hi = draw(member_bounds((n_members, dim)))
     q = draw(st.integers(0, n_members + 1))
-    return Interval._new(lo, hi), q
+    return Interval.trusted(lo, hi), q
 
 
 def _as_set(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -84,7 +84,7 @@ def brute_hull(boxes: Interval, q: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def same(x: Interval, lo: np.ndarray, hi: np.ndarray) -> bool:
-    return bool(np.all(x == Interval._new(np.asarray(lo, float), np.asarray(hi, float))))
+    return bool(np.all(x == Interval.trusted(np.asarray(lo, float), np.asarray(hi, float))))
 
 
 def sample_points(boxes: Interval, rng: np.random.Generator, per_box: int = 20) -> np.ndarray:
@@ -117,7 +117,7 @@ def test_qinter_examples():
 
 def test_qinter_empty_members_are_failures():
     e = np.nan
-    x = Interval._new(np.array([0.0, e, 1.0]), np.array([2.0, e, 3.0]))
+    x = Interval.trusted(np.array([0.0, e, 1.0]), np.array([2.0, e, 3.0]))
     assert qinter(x, 0) == Interval.empty()  # the empty member cannot hold
     assert qinter(x, 1) == Interval(1, 2)  # it is the one failure allowed
     assert qinter(x, 2) == Interval(0, 3)
@@ -134,7 +134,7 @@ def test_qinter_infinite_and_axis_and_errors():
     # axis: members along axis 1 of a (2, 3) array
     z = Interval([[0, 1, 2], [0, 5, 6]], [[3, 4, 5], [1, 7, 8]])
     assert np.all(qinter(z, 1, axis=1) == Interval([1, 6], [4, 7]))
-    assert np.all(qinter(z, 1, axis=-1) == qinter(Interval._new(z.lo.T, z.hi.T), 1))
+    assert np.all(qinter(z, 1, axis=-1) == qinter(Interval.trusted(z.lo.T, z.hi.T), 1))
     with pytest.raises(ValueError, match=">= 0"):
         qinter(x, -1)
     with pytest.raises(TypeError):
@@ -147,19 +147,19 @@ def test_qinter_infinite_and_axis_and_errors():
 @given(st.integers(1, 7).flatmap(lambda n: st.tuples(member_bounds((n,)), st.integers(0, n + 1))))
 def test_qinter_matches_brute_force(args):
     (lo, hi), q = args
-    x = Interval._new(lo, hi)
-    blo, bhi = brute_hull(Interval._new(lo[:, None], hi[:, None]), q)
+    x = Interval.trusted(lo, hi)
+    blo, bhi = brute_hull(Interval.trusted(lo[:, None], hi[:, None]), q)
     assert same(qinter(x, q), blo[0], bhi[0])
 
 
 @settings(max_examples=100)
 @given(member_bounds((4, 3, 5)), st.integers(0, 5), st.sampled_from([0, 1, 2, -1]))
 def test_qinter_batched_equals_one_by_one(bounds, q, axis):
-    x = Interval._new(*bounds)
+    x = Interval.trusted(*bounds)
     got = qinter(x, q, axis=axis)
     lo, hi = np.moveaxis(x.lo, axis, -1), np.moveaxis(x.hi, axis, -1)
     for idx in np.ndindex(lo.shape[:-1]):
-        assert bool(got[idx] == qinter(Interval._new(lo[idx], hi[idx]), q))
+        assert bool(got[idx] == qinter(Interval.trusted(lo[idx], hi[idx]), q))
 
 
 # -- boxes --------------------------------------------------------------------------------------
@@ -181,7 +181,7 @@ def test_qinter_boxes_examples():
 
 def test_qinter_boxes_box_with_an_empty_component_is_empty():
     # box 1 is empty as a whole: its non-empty x component must not count in the projection
-    b = Interval._new(np.array([[0.0, 0.0], [0.0, np.nan], [5.0, 5.0]]),
+    b = Interval.trusted(np.array([[0.0, 0.0], [0.0, np.nan], [5.0, 5.0]]),
                       np.array([[1.0, 1.0], [1.0, np.nan], [6.0, 6.0]]))
     for method in ("exact", "projection"):
         assert np.all(qinter_boxes(b, 1, method).is_empty())
@@ -192,7 +192,7 @@ def test_qinter_boxes_auto_switches_to_projection():
     rng = np.random.default_rng(0)
     n_members = 20
     lo = rng.uniform(-1, 0, (n_members, 2))
-    b = Interval._new(lo, lo + 1.5)
+    b = Interval.trusted(lo, lo + 1.5)
     q = 5
     assert math.comb(n_members, q) > EXACT_MAX_SUBSETS
     assert np.all(qinter_boxes(b, q) == qinter_boxes(b, q, "projection"))
@@ -226,7 +226,7 @@ def test_qinter_boxes_sound_and_ordered(args, seed):
 @settings(max_examples=60)
 @given(member_bounds((3, 4, 2)), st.integers(0, 4), st.sampled_from(["exact", "projection"]))
 def test_qinter_boxes_batched_equals_one_by_one(bounds, q, method):
-    x = Interval._new(*bounds)  # a batch of 3 sets of 4 boxes of dimension 2
+    x = Interval.trusted(*bounds)  # a batch of 3 sets of 4 boxes of dimension 2
     got = qinter_boxes(x, q, method)
     assert got.shape == (3, 2)
     for i in range(3):

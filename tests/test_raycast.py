@@ -321,7 +321,7 @@ def test_empty_and_degenerate_boxes():
     # one empty component empties the box; the other rows of the batch are untouched by it
     lo = np.array([[5.0, 6.5, 0.0, 1.3], [np.nan, 6.5, 0.0, 1.3]])
     hi = np.array([[5.0, 6.5, 0.0, 1.5], [np.nan, 6.5, 0.0, 1.5]])
-    out = CTC(Interval._new(lo, hi))
+    out = CTC(Interval.trusted(lo, hi))
     assert out[1].is_empty().all() and not out[0].is_empty().any()
     assert out.lo[0, 3] <= 1.4 <= out.hi[0, 3]
     # a fully degenerate box: the float 1.4 is not the exact distance 2 - 0.6 of the floats

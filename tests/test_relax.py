@@ -268,7 +268,7 @@ def test_polytope_hull_on_a_batch_and_on_an_empty_csp():
     tape = compile_model(m)
     box = propagate(tape, mode="hc4").slots
     ctc = CtcPolytopeHull(tape, rounds=2)
-    batch = ctc(Interval._new(np.stack([box.lo, box.lo]), np.stack([box.hi, box.hi])))
+    batch = ctc(Interval.trusted(np.stack([box.lo, box.lo]), np.stack([box.hi, box.hi])))
     one = ctc(box)
     assert batch.shape == (2, tape.n_slots)
     assert np.array_equal(batch.lo[1], one.lo) and np.array_equal(batch.hi[0], one.hi)

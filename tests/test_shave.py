@@ -49,7 +49,7 @@ def test_solutions_survive_the_shaving_contractor(csp):
     # a batch: the full box, and boxes around each solution point (with an empty one)
     lo = np.array([[-2.0] * n] + [[max(-2.0, v - 0.3) for v in p] for p in pts] + [[np.nan] * n])
     hi = np.array([[2.0] * n] + [[min(2.0, v + 0.3) for v in p] for p in pts] + [[np.nan] * n])
-    out = ctc(Interval._new(lo, hi))
+    out = ctc(Interval.trusted(lo, hi))
     for p in pts:
         for row in range(len(pts) + 1):
             if np.all((lo[row] <= p) & (p <= hi[row])):

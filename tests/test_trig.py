@@ -577,7 +577,7 @@ def unit_batch(n: int = 400, seed: int = 0) -> Interval:
             a, b = [(-INF, b), (a, INF), (-INF, INF)][int(rng.integers(0, 3))]
         lo.append(min(a, b))
         hi.append(max(a, b))
-    return Interval._new(np.array([*lo, math.nan]), np.array([*hi, math.nan]))
+    return Interval.trusted(np.array([*lo, math.nan]), np.array([*hi, math.nan]))
 
 
 def check_inverse_batch(name: str, x: Interval, y: Interval) -> None:
@@ -628,20 +628,20 @@ def test_inverse_out_and_layouts(name):
         assert np.array_equal(r.lo.ravel(), ref.lo, equal_nan=True)
         assert np.array_equal(r.hi.ravel(), ref.hi, equal_nan=True)
 
-    out = Interval._new(np.empty(n), np.empty(n))
+    out = Interval.trusted(np.empty(n), np.empty(n))
     assert f(x, out=out) is out
     same_as_ref(out)
-    y = Interval._new(x.lo.copy(), x.hi.copy())
+    y = Interval.trusted(x.lo.copy(), x.hi.copy())
     f(y, out=y)
     same_as_ref(y)
     big = np.empty((4, n))
     big[0], big[2] = x.lo, x.hi
-    xs = Interval._new(big[0::2].T[:, 0], big[0::2].T[:, 1])
-    outs = Interval._new(np.empty(2 * n)[::2], np.empty(2 * n)[1::2])
+    xs = Interval.trusted(big[0::2].T[:, 0], big[0::2].T[:, 1])
+    outs = Interval.trusted(np.empty(2 * n)[::2], np.empty(2 * n)[1::2])
     f(xs, out=outs)
     same_as_ref(outs)
-    same_as_ref(f(Interval._new(x.lo.reshape(100, 50), x.hi.reshape(100, 50))))
-    small = Interval._new(np.empty(7), np.empty(7))
+    same_as_ref(f(Interval.trusted(x.lo.reshape(100, 50), x.hi.reshape(100, 50))))
+    small = Interval.trusted(np.empty(7), np.empty(7))
     f(x[:7], out=small)
     assert np.array_equal(small.hi, ref.hi[:7], equal_nan=True)
 

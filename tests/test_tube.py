@@ -91,14 +91,14 @@ def widen(x: Interval, rng: np.random.Generator, p_entire: float = 0.0) -> Inter
     r = rng.uniform(0, 0.5, x.shape) * rng.integers(0, 2, x.shape)
     out = x.inflate(r)
     mask = rng.random(x.shape) < p_entire
-    return Interval._new(np.where(mask, -INF, out.lo), np.where(mask, INF, out.hi))
+    return Interval.trusted(np.where(mask, -INF, out.lo), np.where(mask, INF, out.hi))
 
 
 def tube_around(tr: Traj, t: np.ndarray, rng: np.random.Generator, p_entire: float = 0.0,
                 deriv: bool = False) -> Tube:
     f = tr.enclose_deriv if deriv else tr.enclose
-    slices = widen(f(Interval._new(t[:-1], t[1:])), rng, p_entire)
-    gates = widen(f(Interval._new(t, t)), rng, p_entire)
+    slices = widen(f(Interval.trusted(t[:-1], t[1:])), rng, p_entire)
+    gates = widen(f(Interval.trusted(t, t)), rng, p_entire)
     return Tube(t, slices, gates)
 
 

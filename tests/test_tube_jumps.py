@@ -73,7 +73,7 @@ class Jumpy:
         meets = (self.tau[:-1][None, :] < hi[:, None]) & (self.tau[1:][None, :] > lo[:, None])
         c_lo = np.min(np.where(meets, self.c[None, :], INF), axis=1)
         c_hi = np.max(np.where(meets, self.c[None, :], -INF), axis=1)
-        return Interval(c_lo, c_hi) + self.g.enclose_deriv(Interval._new(lo, hi))
+        return Interval(c_lo, c_hi) + self.g.enclose_deriv(Interval.trusted(lo, hi))
 
 
 @st.composite

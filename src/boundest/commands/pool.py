@@ -275,7 +275,7 @@ def _online(data, kw: dict):
         empty.append(emp)
         cells.append(obs.cells_kept)
     probs = window_probabilities(data.n, kw["m"], kw["q"], data.p_outlier)
-    res = PoolResult(Interval._new(np.stack([b.lo for b in boxes]),
+    res = PoolResult(Interval.trusted(np.stack([b.lo for b in boxes]),
                                    np.stack([b.hi for b in boxes])),
                      np.array(rejected), np.array(empty), probs, kw["q"], kw["m"],
                      float(sum(times)), np.array(cells), eps=obs.paving)

@@ -67,8 +67,8 @@ def draw_figure(res, k_max: int, out: str) -> None:
     from ..plot import plot_boxes
 
     fig, ax = subplots(figsize=(6.5, 6))
-    plot_boxes(Interval._new(res.x_lo[:, 0], res.x_hi[:, 0]),
-               Interval._new(res.x_lo[:, 1], res.x_hi[:, 1]), ax=ax,
+    plot_boxes(Interval.trusted(res.x_lo[:, 0], res.x_hi[:, 0]),
+               Interval.trusted(res.x_lo[:, 1], res.x_hi[:, 1]), ax=ax,
                label="box [x1](k) x [x2](k), one per k")
     ax.plot(0, 0, "o", color="tab:green", ms=10, label="earth")
     ax.set_xlabel("x1 (length unit of the model, G M = 1)")

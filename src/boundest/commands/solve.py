@@ -129,7 +129,7 @@ def pave(model: Any, domains: dict[str, Any], eps: float, max_boxes: int) -> Any
         raise ValueError(f"a subpaving needs bounded domains; after propagation "
                          f"{', '.join(unb)} {'is' if len(unb) == 1 else 'are'} unbounded")
     ctc = CtcFwdBwd(model.constraints, names)
-    return sivia(Interval._new(lo, hi), ctc_out=ctc, eps=eps, max_boxes=max_boxes)
+    return sivia(Interval.trusted(lo, hi), ctc_out=ctc, eps=eps, max_boxes=max_boxes)
 
 
 _WHY = {"eps": "narrower than eps without a proof (a multiple or singular root, or no root "

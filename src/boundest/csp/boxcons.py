@@ -142,4 +142,4 @@ class CtcBox(Contractor):
             bc_boxes(t.op, t.out, t.a, t.b, t.param, t.lo, t.hi, self._slot, lo, hi, self._cand,
                      self._cptr, self._cnodes, self.eps, self.max_depth, self.max_steps,
                      *self._families)
-        return _empty_rows(Interval._new(lo.reshape(shape), hi.reshape(shape)))
+        return _empty_rows(Interval.trusted(lo.reshape(shape), hi.reshape(shape)))

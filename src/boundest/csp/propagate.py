@@ -526,10 +526,10 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
     if not consistent:
         lo[:] = np.nan
         hi[:] = np.nan
-    doms = {name: Interval._new(lo[s], hi[s]) for name, s in tape.slot_of.items()}
+    doms = {name: Interval.trusted(lo[s], hi[s]) for name, s in tape.slot_of.items()}
     return Propagation(domains=doms, consistent=consistent, evaluations=evaluations,
                        iterations=evaluations / max(n, 1), time_s=elapsed, n_nodes=n,
-                       n_slots=tape.n_slots, slots=Interval._new(lo, hi), mode=mode,
+                       n_slots=tape.n_slots, slots=Interval.trusted(lo, hi), mode=mode,
                        shaving=shave_info, boxcons=bc_info, linear=lp_info,
                        centered=ctr_info)
 

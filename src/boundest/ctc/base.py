@@ -74,7 +74,7 @@ def _empty_rows(x: Interval) -> Interval:
         lo, hi = x.lo.copy(), x.hi.copy()
         lo[bad] = np.nan
         hi[bad] = np.nan
-        return Interval._new(lo, hi)
+        return Interval.trusted(lo, hi)
     return x
 
 

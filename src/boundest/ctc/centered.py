@@ -362,7 +362,7 @@ class CtcCentered(_Linearised):
             stats = np.zeros(len(WINDOW_STATS), dtype=np.int64)
             batch_kernel(entries.lo, entries.hi, t.row_ptr, t.cols, fc.lo, fc.hi, tl, th, lo,
                          hi, c, 20 * (t.n_outputs + self.n) + 200, stats)
-        return _empty_rows(Interval._new(lo.reshape(x.shape), hi.reshape(x.shape)))
+        return _empty_rows(Interval.trusted(lo.reshape(x.shape), hi.reshape(x.shape)))
 
 
 @_njit
@@ -466,7 +466,7 @@ class CtcNewton(_Linearised):
         t = self.tape
         _newton_kernel(entries.lo, entries.hi, t.row_ptr, t.cols, fc.lo, fc.hi, ok,
                        t.target_lo, t.target_hi, lo, hi, c, proved)
-        out = _empty_rows(Interval._new(lo.reshape(x.shape), hi.reshape(x.shape)))
+        out = _empty_rows(Interval.trusted(lo.reshape(x.shape), hi.reshape(x.shape)))
         return out, proved.reshape(x.shape[:-1])
 
     def contract(self, x: Interval) -> Interval:

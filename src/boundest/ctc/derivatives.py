@@ -450,7 +450,7 @@ def evaluate(tape: FunctionTape | Any, box: ArrayLike | Interval) -> Interval:
     box = as_interval(box)
     lo, hi, batch = _slots(tape, box)
     forward_kernel(*_args(tape), lo, hi, *family_flags(tape.op))
-    return Interval._new(lo[:, tape.out_slot].reshape(*batch, -1),
+    return Interval.trusted(lo[:, tape.out_slot].reshape(*batch, -1),
                          hi[:, tape.out_slot].reshape(*batch, -1))
 
 
@@ -469,9 +469,9 @@ def jacobian_sparse(tape: FunctionTape, box: ArrayLike | Interval, with_defined:
     ok = np.empty(lo.shape[0], dtype=np.bool_)
     jacobian_kernel(*_args(tape), tape.node_ptr, tape.out_slot, tape.row_ptr, tape.cols, lo, hi,
                     jl, jh, ok, *family_flags(tape.op))
-    values = Interval._new(lo[:, tape.out_slot].reshape(*batch, -1),
+    values = Interval.trusted(lo[:, tape.out_slot].reshape(*batch, -1),
                            hi[:, tape.out_slot].reshape(*batch, -1))
-    entries = Interval._new(jl.reshape(*batch, nnz), jh.reshape(*batch, nnz))
+    entries = Interval.trusted(jl.reshape(*batch, nnz), jh.reshape(*batch, nnz))
     if with_defined:
         return values, entries, ok.reshape(batch)
     return values, entries
@@ -510,7 +510,7 @@ def jacobian(tape: FunctionTape | Any, box: ArrayLike | Interval) -> tuple[Inter
     rows = _row_index(tape)
     jl[..., rows, tape.cols] = entries.lo
     jh[..., rows, tape.cols] = entries.hi
-    return values, Interval._new(jl, jh)
+    return values, Interval.trusted(jl, jh)
 
 
 def centered(tape: FunctionTape | Any, box: ArrayLike | Interval,
@@ -546,9 +546,9 @@ def centered(tape: FunctionTape | Any, box: ArrayLike | Interval,
     total_lo = np.zeros(natural.shape)
     total_hi = np.zeros(natural.shape)
     _sum_rows(terms.lo, terms.hi, rows, total_lo, total_hi)
-    cf = fc + Interval._new(total_lo, total_hi)
+    cf = fc + Interval.trusted(total_lo, total_hi)
     # an empty f(c) (c outside some primitive's domain) gives no centered information
-    cf = Interval._new(np.where(np.isnan(fc.lo), -np.inf, cf.lo),
+    cf = Interval.trusted(np.where(np.isnan(fc.lo), -np.inf, cf.lo),
                        np.where(np.isnan(fc.lo), np.inf, cf.hi))
     return natural & cf
 

@@ -93,7 +93,7 @@ class CtcFwdBwd(Contractor):
         lo[bad] = hi[bad] = np.nan
 
         def dom(s: int) -> Interval:
-            return Interval._new(lo[s], hi[s])
+            return Interval.trusted(lo[s], hi[s])
 
         def put(s: int, v: Interval) -> None:
             lo[s], hi[s] = v.lo, v.hi
@@ -120,7 +120,7 @@ class CtcFwdBwd(Contractor):
                 else:
                     put(a, xa)
                     put(b, xb)
-        out = Interval._new(np.moveaxis(lo[self._slots], 0, -1),
+        out = Interval.trusted(np.moveaxis(lo[self._slots], 0, -1),
                             np.moveaxis(hi[self._slots], 0, -1))
         empty = np.isnan(lo).any(axis=0)  # a box with one empty slot is empty
         res = _empty_rows(iv.intersect(x, out))

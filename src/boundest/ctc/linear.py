@@ -137,9 +137,9 @@ def _segment_sum(lo: NDArray[np.float64], hi: NDArray[np.float64], seg: NDArray[
 
 def _column_sums(system: LinearSystem, y: NDArray[np.float64]) -> Interval:
     """``[A]^T y`` in interval arithmetic, shape ``(n_cols,)``."""
-    prod = Interval._new(system.a_lo, system.a_hi) * Interval(y[system.rows])
+    prod = Interval.trusted(system.a_lo, system.a_hi) * Interval(y[system.rows])
     lo, hi = _segment_sum(prod.lo, prod.hi, system.cols, system.n_cols)
-    return Interval._new(lo, hi)
+    return Interval.trusted(lo, hi)
 
 
 def safe_lower_bound(system: LinearSystem, c: NDArray[np.float64], y: NDArray[np.float64],
@@ -168,8 +168,8 @@ def safe_lower_bound(system: LinearSystem, c: NDArray[np.float64], y: NDArray[np
     y = np.where(system.b_lo == -np.inf, np.minimum(y, 0.0), y)
     y = np.where(system.b_hi == np.inf, np.maximum(y, 0.0), y)
     r = Interval(np.asarray(c, dtype=np.float64)) - _column_sums(system, y)
-    terms_x = r * Interval._new(lo, hi)
-    terms_b = Interval(y) * Interval._new(system.b_lo, system.b_hi)
+    terms_x = r * Interval.trusted(lo, hi)
+    terms_b = Interval(y) * Interval.trusted(system.b_lo, system.b_hi)
     lo_terms = np.concatenate([terms_x.lo, terms_b.lo])
     if np.isnan(lo_terms).any():
         return -np.inf
@@ -377,10 +377,10 @@ class _Rows:
         g = inv[order]
         start = np.searchsorted(g, np.arange(uniq.size))
         rank = np.arange(g.size) - start[g]
-        acc = Interval._new(np.zeros(uniq.size), np.zeros(uniq.size))
+        acc = Interval.trusted(np.zeros(uniq.size), np.zeros(uniq.size))
         for k in range(int(rank.max()) + 1 if rank.size else 0):
             sel = order[rank == k]
-            part = acc[inv[sel]] + Interval._new(lo[sel], hi[sel])
+            part = acc[inv[sel]] + Interval.trusted(lo[sel], hi[sel])
             acc.lo[inv[sel]], acc.hi[inv[sel]] = part.lo, part.hi
         acc_lo, acc_hi = acc.lo, acc.hi
         b_lo, b_hi = np.zeros(self.n), np.zeros(self.n)
@@ -394,7 +394,7 @@ def _log_abs(lo: NDArray, hi: NDArray) -> tuple[NDArray, NDArray]:
     """An enclosure of ``log|x|`` over sign-definite ``[lo, hi]`` (``lo > 0`` or ``hi < 0``)."""
     neg = hi < 0
     mlo, mhi = np.where(neg, -hi, lo), np.where(neg, -lo, hi)
-    L = log(Interval._new(mlo, mhi))
+    L = log(Interval.trusted(mlo, mhi))
     return L.lo, L.hi
 
 
@@ -637,10 +637,10 @@ class CtcLinear(Contractor):
         if x.ndim > 1:  # each box of a batch by its own LPs
             flat = x.reshape(-1, self.n)
             parts = [self.contract(flat[i]) for i in range(flat.shape[0])]
-            return Interval._new(np.stack([p.lo for p in parts]).reshape(x.shape),
+            return Interval.trusted(np.stack([p.lo for p in parts]).reshape(x.shape),
                                  np.stack([p.hi for p in parts]).reshape(x.shape))
         lo, hi, ok = self._contract_box(x.lo, x.hi)
-        return Interval._new(lo, hi) if ok else Interval.empty(x.shape)
+        return Interval.trusted(lo, hi) if ok else Interval.empty(x.shape)
 
     def _contract_box(self, lo: NDArray[np.float64], hi: NDArray[np.float64]
                       ) -> tuple[NDArray[np.float64], NDArray[np.float64], bool]:
@@ -672,7 +672,7 @@ def contract_slots(tape: Tape, lo: NDArray[np.float64], hi: NDArray[np.float64],
     hi = np.minimum(hi, chi[:tape.n_slots])
     # back from log|x|: |x| in exp([L, U]), with the sign of the slot's domain
     s = ext.log_slots
-    m = exp(Interval._new(clo[tape.n_slots:], chi[tape.n_slots:]))
+    m = exp(Interval.trusted(clo[tape.n_slots:], chi[tape.n_slots:]))
     neg = hi[s] < 0
     lo[s] = np.where(neg, np.maximum(lo[s], -m.hi), np.maximum(lo[s], m.lo))
     hi[s] = np.where(neg, np.minimum(hi[s], -m.lo), np.minimum(hi[s], m.hi))

@@ -166,7 +166,7 @@ class CtcPolar(Contractor):
             _polar_rows(lo, hi)
         else:
             _polar_rows_about(lo, hi, *self.center)
-        return Interval._new(lo.reshape(x.shape), hi.reshape(x.shape))
+        return Interval.trusted(lo.reshape(x.shape), hi.reshape(x.shape))
 
 
 @_njit

@@ -88,6 +88,6 @@ class CtcQInter(Contractor):
         if self.q >= len(self.ctcs):
             return x.copy()
         parts = [_empty_rows(intersect(x, c.contract(x))) for c in self.ctcs]
-        stacked = Interval._new(np.stack([p.lo for p in parts], axis=-2),
+        stacked = Interval.trusted(np.stack([p.lo for p in parts], axis=-2),
                                 np.stack([p.hi for p in parts], axis=-2))
         return _empty_rows(intersect(x, qinter_boxes(stacked, self.q, self.method)))

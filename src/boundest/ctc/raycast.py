@@ -192,7 +192,7 @@ class CtcRayCast(Contractor):
         lo = np.ascontiguousarray(x.lo, dtype=np.float64).reshape(-1, 4).copy()
         hi = np.ascontiguousarray(x.hi, dtype=np.float64).reshape(-1, 4).copy()
         _raycast_boxes(lo, hi, passes, parts, *self.tapes)
-        return Interval._new(lo.reshape(x.shape), hi.reshape(x.shape))
+        return Interval.trusted(lo.reshape(x.shape), hi.reshape(x.shape))
 
 
 _njit = nb.njit(cache=True, error_model="numpy")

@@ -135,7 +135,7 @@ def _pt(v: NDArray) -> Interval:
     """Degenerate intervals at finite points (non-finite ones replaced by 0; the caller
     drops their rows)."""
     v = np.where(np.isfinite(v), v, 0.0)
-    return Interval._new(v, v.copy())
+    return Interval.trusted(v, v.copy())
 
 
 def _mccormick(z: NDArray, x: NDArray, y: NDArray, lo: NDArray, hi: NDArray) -> list[RowBlock]:
@@ -169,11 +169,11 @@ def _convex(z: NDArray, x: NDArray, xl: NDArray, xh: NDArray, curv: NDArray,
 
     def g(p: Interval) -> Interval:  # cv * f, exact negation
         v = f(p)
-        return Interval._new(np.where(neg, -v.hi, v.lo), np.where(neg, -v.lo, v.hi))
+        return Interval.trusted(np.where(neg, -v.hi, v.lo), np.where(neg, -v.lo, v.hi))
 
     def dg(p: Interval) -> Interval:
         v = df(p)
-        return Interval._new(np.where(neg, -v.hi, v.lo), np.where(neg, -v.lo, v.hi))
+        return Interval.trusted(np.where(neg, -v.hi, v.lo), np.where(neg, -v.lo, v.hi))
 
     out = []
     # secant: cv z - s x <= d
@@ -200,7 +200,7 @@ def _convex(z: NDArray, x: NDArray, xl: NDArray, xh: NDArray, curv: NDArray,
         # mag * dmax rounded up; an unbounded side still gives a row where mag = 0
         E = (_pt(mag) * _pt(dmax)).hi
         E = np.where(fin, E, np.where(mag == 0, 0.0, np.inf))
-        e = (g(P) - S * P - Interval._new(E, E)).lo
+        e = (g(P) - S * P - Interval.trusted(E, E)).lo
         valid = ok & np.isfinite(p) & np.isfinite(D.lo) & np.isfinite(D.hi)
         out.append(_block([x, z], [s, -cv], -e, valid))
     return out
@@ -244,7 +244,7 @@ def _unary_rows(tape: Tape, lo: NDArray, hi: NDArray, keep: NDArray) -> list[Row
     asg = np.where(al >= 0, 1, np.where(ah <= 0, -1, 0))
     add(sel("asin") & (al <= ah), asg, asin, _recip_sqrt_1m, xl=al, xh=ah)
     add(sel("acos") & (al <= ah), -asg, acos, lambda p: -_recip_sqrt_1m(p), xl=al, xh=ah)
-    X = Interval._new(np.where(np.isfinite(xl), xl, 0.0), np.where(np.isfinite(xh), xh, 0.0))
+    X = Interval.trusted(np.where(np.isfinite(xl), xl, 0.0), np.where(np.isfinite(xh), xh, 0.0))
     bounded = np.isfinite(xl) & np.isfinite(xh)
     for name, f, df in (("sin", sin, cos), ("cos", cos, lambda p: -sin(p)),
                         ("tan", tan, lambda p: 1.0 + sqr(tan(p)))):

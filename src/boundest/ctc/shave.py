@@ -94,7 +94,7 @@ class CtcShave(Contractor):
                         shi[..., i] = np.where(todo, cut, h)
                     else:
                         slo[..., i] = np.where(todo, cut, l)
-                    sl = self.ctc.contract(Interval._new(slo, shi))
+                    sl = self.ctc.contract(Interval.trusted(slo, shi))
                     refuted = todo & np.isnan(sl.lo).any(axis=-1)
                     if not refuted.any():
                         break
@@ -103,8 +103,8 @@ class CtcShave(Contractor):
                         lo[..., i] = np.where(refuted, cut, l)
                     else:
                         hi[..., i] = np.where(refuted, cut, h)
-                    out = _empty_rows(self.ctc.contract(Interval._new(lo, hi)))
+                    out = _empty_rows(self.ctc.contract(Interval.trusted(lo, hi)))
                     lo, hi = out.lo.copy(), out.hi.copy()
                     todo = refuted & ~np.isnan(lo).any(axis=-1)
                     f = np.minimum(2.0 * f, 0.5)
-        return Interval._new(lo, hi)
+        return Interval.trusted(lo, hi)

@@ -331,10 +331,10 @@ def contract_windows(tape: FunctionTape, xl: NDArray[np.float64], xh: NDArray[np
     from ..interval import Interval
     from .derivatives import evaluate, jacobian_sparse, midpoint
 
-    box = Interval._new(xl.copy(), xh.copy())
+    box = Interval.trusted(xl.copy(), xh.copy())
     c = midpoint(box)
     _, entries = jacobian_sparse(tape, box)
-    fc = evaluate(tape, Interval._new(c, c))
+    fc = evaluate(tape, Interval.trusted(c, c))
     win_lo, win_hi, tptr, tvars = windows
     stats = np.zeros(len(WINDOW_STATS), dtype=np.int64)
     if max_iter <= 0:

@@ -156,4 +156,4 @@ class CellGrid:
     def cells(self) -> Interval:
         """The known cells as boxes ``(c, m)`` (exact: integers times a power of two)."""
         idx = np.argwhere(self.known) + self.glo
-        return Interval._new(idx * self.h, (idx + 1) * self.h)
+        return Interval.trusted(idx * self.h, (idx + 1) * self.h)

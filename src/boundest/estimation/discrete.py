@@ -109,7 +109,7 @@ class ChainEstimate:
         """Interval hulls of the ``x`` domains, shape ``(..., K + 1, nx)``."""
         hs = [d.hull() if isinstance(d, Subpaving) else d for d in self.x]
         shape = np.broadcast_shapes(*(h.shape for h in hs))
-        return Interval._new(np.stack([np.broadcast_to(h.lo, shape) for h in hs], axis=-2),
+        return Interval.trusted(np.stack([np.broadcast_to(h.lo, shape) for h in hs], axis=-2),
                              np.stack([np.broadcast_to(h.hi, shape) for h in hs], axis=-2))
 
 

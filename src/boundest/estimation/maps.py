@@ -77,14 +77,14 @@ class Map:
         if bad.any():  # an empty box, or h undefined on the whole box: empty image
             lo, hi = lo.copy(), hi.copy()
             lo[bad] = hi[bad] = np.nan
-        return Interval._new(lo, hi)
+        return Interval.trusted(lo, hi)
 
     def contract(self, u: Interval, v: Interval, *, once: bool = False
                  ) -> tuple[Interval, Interval]:
         """Hull-consistent contraction of ``(u, v)`` (broadcast batches) by ``v = h(u)``; with
         ``once``, a single forward-backward pass instead of the fixpoint."""
         shape = np.broadcast_shapes(u.shape[:-1], v.shape[:-1])
-        joint = Interval._new(
+        joint = Interval.trusted(
             np.concatenate([np.broadcast_to(u.lo, (*shape, self.n_in)),
                             np.broadcast_to(v.lo, (*shape, self.n_out))], axis=-1),
             np.concatenate([np.broadcast_to(u.hi, (*shape, self.n_in)),
@@ -94,5 +94,5 @@ class Map:
         lo[..., self._cols], hi[..., self._cols] = sub.lo, sub.hi
         empty = np.isnan(lo).any(axis=-1)
         lo[empty] = hi[empty] = np.nan
-        c = Interval._new(lo, hi)
+        c = Interval.trusted(lo, hi)
         return c[..., :self.n_in], c[..., self.n_in:]

@@ -123,7 +123,7 @@ class RobustObserver:
         else:
             pred, hyp = self.x, self.hyp
         new = self.observe(pred, y)
-        stack = Interval._new(np.concatenate([hyp.lo, new.lo[..., None, :]], axis=-2),
+        stack = Interval.trusted(np.concatenate([hyp.lo, new.lo[..., None, :]], axis=-2),
                               np.concatenate([hyp.hi, new.hi[..., None, :]], axis=-2))
         if stack.shape[-2] > self.m:
             stack = stack[..., 1:, :]
@@ -136,10 +136,10 @@ class RobustObserver:
         if empty.any():  # restart those rows from the restart box, with a neutral window
             rb = np.broadcast_to(self.restart_box.lo, x.shape), np.broadcast_to(
                 self.restart_box.hi, x.shape)
-            x = Interval._new(np.where(empty[..., None], rb[0], x.lo),
+            x = Interval.trusted(np.where(empty[..., None], rb[0], x.lo),
                               np.where(empty[..., None], rb[1], x.hi))
             e = empty[..., None, None]
-            stack = Interval._new(np.where(e, -np.inf, stack.lo), np.where(e, np.inf, stack.hi))
+            stack = Interval.trusted(np.where(e, -np.inf, stack.lo), np.where(e, np.inf, stack.hi))
         self.x, self.hyp, self.k = x, stack, self.k + 1
         return ObserverStep(x, rejected, empty, stack.shape[-2])
 

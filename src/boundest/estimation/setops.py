@@ -109,7 +109,7 @@ def _against(target: Domain, y: Interval) -> tuple[NDArray[np.int8], Interval]:
         meet = np.all((y.lo <= target.hi) & (target.lo <= y.hi), axis=1) & ~empty
         inside = np.all((target.lo <= y.lo) & (y.hi <= target.hi), axis=1) & meet
         cls = np.where(inside, 1, np.where(meet, 0, -1)).astype(np.int8)
-        return cls, Interval._new(np.broadcast_to(target.lo, (b, m)),
+        return cls, Interval.trusted(np.broadcast_to(target.lo, (b, m)),
                                   np.broadcast_to(target.hi, (b, m)))
     tb = target.boxes
     ylo, yhi = np.where(empty[:, None], np.inf, y.lo), np.where(empty[:, None], -np.inf, y.hi)
@@ -123,7 +123,7 @@ def _against(target: Domain, y: Interval) -> tuple[NDArray[np.int8], Interval]:
     cls = np.where(meets, 0, -1).astype(np.int8)
     cls[i[sub]] = 1
     lo[~meets] = hi[~meets] = np.nan
-    return cls, Interval._new(lo, hi)
+    return cls, Interval.trusted(lo, hi)
 
 
 def _bisect(x: Interval) -> Interval:
@@ -152,8 +152,8 @@ def _pop(stack: list[Interval], size: int) -> Interval:
 
 def _cat(parts: list[Interval], n: int) -> Interval:
     if not parts:
-        return Interval._new(np.empty((0, n)), np.empty((0, n)))
-    return Interval._new(np.concatenate([p.lo for p in parts]).reshape(-1, n),
+        return Interval.trusted(np.empty((0, n)), np.empty((0, n)))
+    return Interval.trusted(np.concatenate([p.lo for p in parts]).reshape(-1, n),
                          np.concatenate([p.hi for p in parts]).reshape(-1, n))
 
 
@@ -290,7 +290,7 @@ class PavingSets:
             y = m(u)
             if grid is not None:
                 p = u.mid()  # points of V_in
-                grid.certify(m(Interval._new(p, p)))
+                grid.certify(m(Interval.trusted(p, p)))
                 keep = ~grid.covered(y)
                 u, y = u[keep], y[keep]
             done = y.max_diam() <= eps

@@ -81,7 +81,7 @@ class FunctionTape:
 
     def targets(self) -> Interval:
         """The target set of every output, shape ``(m,)``."""
-        return Interval._new(self.target_lo.copy(), self.target_hi.copy())
+        return Interval.trusted(self.target_lo.copy(), self.target_hi.copy())
 
 
 def function_tape(outputs: Sequence[Expr | float], names: Sequence[str | Var] | None = None,

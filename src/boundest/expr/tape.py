@@ -74,7 +74,7 @@ class Tape:
 
     def domains(self) -> Interval:
         """The initial domains of all slots."""
-        return Interval._new(self.lo.copy(), self.hi.copy())
+        return Interval.trusted(self.lo.copy(), self.hi.copy())
 
     def describe(self) -> str:
         names = {s: n for n, s in self.slot_of.items()}

@@ -120,6 +120,26 @@ class Interval:
         return obj
 
     @classmethod
+    def trusted(cls, lo: ArrayLike, hi: ArrayLike) -> Interval:
+        """Wrap bounds that the caller vouches for: no checks, no copies.
+
+        For code that computed the bounds itself, rounded outward (a kernel, a contractor):
+        ``lo`` and ``hi`` of one shape, ``lo <= hi``, no ``+inf`` lower bound or ``-inf``
+        upper bound, and NaN in both bounds of an empty component. Float64 arrays are wrapped
+        as they are, so later writes to them change the interval. Nothing is checked: bounds
+        that break these rules give wrong results, not errors. Use ``Interval(lo, hi)`` for
+        anything a user or a file gave.
+
+        Examples
+        --------
+        >>> lo, hi = np.array([0.0, np.nan]), np.array([1.0, np.nan])
+        >>> x = Interval.trusted(lo, hi)
+        >>> x.lo is lo, x.is_empty()
+        (True, array([False,  True]))
+        """
+        return cls._new(lo, hi)
+
+    @classmethod
     def empty(cls, shape: int | tuple[int, ...] = ()) -> Interval:
         """The empty set (``[nan, nan]``), of the given shape."""
         return cls._new(np.full(shape, np.nan), np.full(shape, np.nan))

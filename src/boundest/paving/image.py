@@ -16,7 +16,7 @@ Examples
 >>> from boundest.interval import Interval
 >>> def f(x):  # x -> 3 (sin(x1 + x2), cos(x1 + x2)), Jaulin et al. 2001 equation 21
 ...     s = x[:, 0] + x[:, 1]
-...     return Interval._new(np.stack([(3 * iv.sin(s)).lo, (3 * iv.cos(s)).lo], axis=1),
+...     return Interval.trusted(np.stack([(3 * iv.sin(s)).lo, (3 * iv.cos(s)).lo], axis=1),
 ...                          np.stack([(3 * iv.sin(s)).hi, (3 * iv.cos(s)).hi], axis=1))
 >>> v = Subpaving.from_box(Interval([-0.1, -0.1], [0.1, 0.1]))
 >>> w = image(v, f, eps=0.05)
@@ -125,7 +125,7 @@ def pave(y: Interval, eps: float) -> Subpaving:
         rhi = hi[~snap].max(axis=0, keepdims=True)
         clo, chi, _ = _subtract(clo, chi, rlo, rhi)
         clo, chi = np.concatenate([clo, rlo]), np.concatenate([chi, rhi])
-    out = Subpaving(Interval._new(clo, chi), np.zeros(clo.shape[0], dtype=bool))
+    out = Subpaving(Interval.trusted(clo, chi), np.zeros(clo.shape[0], dtype=bool))
     out.stats = {"images": int(lo.shape[0]), "cells": int(idx.shape[0])}
     return out
 
@@ -206,7 +206,7 @@ def image(sp: Subpaving, f: Callable[[Interval], Interval], *, eps: float,
         out = Subpaving.empty(sp.dim)
         out.stats = {"bisected": 0, "images": 0, "cells": 0}
         return out
-    out = pave(Interval._new(np.concatenate([d.lo for d in done]).reshape(-1, m),
+    out = pave(Interval.trusted(np.concatenate([d.lo for d in done]).reshape(-1, m),
                              np.concatenate([d.hi for d in done]).reshape(-1, m)), eps)
     out.stats = {"bisected": count, **out.stats}
     return out
@@ -261,6 +261,6 @@ def _bisect(job: _ImagePart, frontier: Interval, *, budget: int | None = None,
             frontier = frontier[:0]
             break
         left, right = frontier[wide].bisect()
-        frontier = Interval._new(np.concatenate([left.lo, right.lo]),
+        frontier = Interval.trusted(np.concatenate([left.lo, right.lo]),
                                  np.concatenate([left.hi, right.hi]))
     return _Bisected(done, count, m, frontier)

@@ -50,7 +50,7 @@ class _Nothing(Contractor):
     """The contractor of the empty set (used for the complement of ``y = R^m``)."""
 
     def contract(self, x: Interval) -> Interval:
-        return Interval._new(np.full(x.shape, np.nan), np.full(x.shape, np.nan))
+        return Interval.trusted(np.full(x.shape, np.nan), np.full(x.shape, np.nan))
 
 
 def separators(f: Expr | Sequence[Expr], y: Interval, variables_: Sequence[str] | None = None
@@ -89,7 +89,7 @@ def _contract(ctc: Contractor | Callable[[Interval], Interval], x: Interval) -> 
     bad = np.any(np.isnan(lo) | np.isnan(hi) | (lo > hi), axis=1)
     lo[bad] = np.nan
     hi[bad] = np.nan
-    return Interval._new(lo, hi)
+    return Interval.trusted(lo, hi)
 
 
 def _classify(x: Interval, test: Test | None, ctc_in: Contractor | None,
@@ -119,8 +119,8 @@ def _classify(x: Interval, test: Test | None, ctc_in: Contractor | None,
 
 def _cat(parts: list[Interval], n: int) -> Interval:
     if not parts:
-        return Interval._new(np.empty((0, n)), np.empty((0, n)))
-    return Interval._new(np.concatenate([p.lo for p in parts]),
+        return Interval.trusted(np.empty((0, n)), np.empty((0, n)))
+    return Interval.trusted(np.concatenate([p.lo for p in parts]),
                          np.concatenate([p.hi for p in parts]))
 
 
@@ -303,7 +303,7 @@ def _pave(frontier: Interval, *, test, ctc_in, ctc_out, eps: float, keep_outside
             stopped = "max_boxes" if big.shape[0] else stopped
             break
         left, right = big.bisect()
-        frontier = Interval._new(np.concatenate([left.lo, right.lo]),
+        frontier = Interval.trusted(np.concatenate([left.lo, right.lo]),
                                  np.concatenate([left.hi, right.hi]))
     return _Run(inside, boundary, outside, frontier[:0], iterations, processed, stopped)
 

@@ -158,7 +158,7 @@ def box_difference(x: Interval, c: Interval) -> tuple[Interval, NDArray[np.intp]
     parent = np.concatenate([rows[keep_low], rows[keep_up], full])
     pieces_lo = np.concatenate([pieces_lo, x.lo[full]])
     pieces_hi = np.concatenate([pieces_hi, x.hi[full]])
-    return Interval._new(pieces_lo.reshape(-1, n), pieces_hi.reshape(-1, n)), parent
+    return Interval.trusted(pieces_lo.reshape(-1, n), pieces_hi.reshape(-1, n)), parent
 
 
 def _subtract(lo: NDArray, hi: NDArray, qlo: NDArray, qhi: NDArray) -> tuple[NDArray, NDArray,
@@ -183,8 +183,8 @@ def _subtract(lo: NDArray, hi: NDArray, qlo: NDArray, qhi: NDArray) -> tuple[NDA
         if not hit.any():
             break
         first_i, first = np.unique(i, return_index=True)
-        pieces, src = box_difference(Interval._new(lo[first_i], hi[first_i]),
-                                     Interval._new(qlo[j[first]], qhi[j[first]]))
+        pieces, src = box_difference(Interval.trusted(lo[first_i], hi[first_i]),
+                                     Interval.trusted(qlo[j[first]], qhi[j[first]]))
         # a degenerate piece of a degenerate box inside q is covered by q
         lo, hi, parent = pieces.lo, pieces.hi, parent[first_i][src]
         covered = pieces.is_empty().any(axis=1)
@@ -235,7 +235,7 @@ class Subpaving:
             k = int(np.flatnonzero(bad)[0])
             raise ValueError(f"subpaving box {k} is empty or invalid: {boxes[k]}")
         if outside is None:
-            outside = Interval._new(np.empty((0, n)), np.empty((0, n)))
+            outside = Interval.trusted(np.empty((0, n)), np.empty((0, n)))
         outside = _as_boxes(outside, "outside")
         if outside.shape[1] != n:
             raise ValueError(f"outside boxes have dimension {outside.shape[1]}, the subpaving "
@@ -256,7 +256,7 @@ class Subpaving:
     @classmethod
     def empty(cls, dim: int) -> Subpaving:
         """The empty subpaving of ``R^dim``."""
-        return cls(Interval._new(np.empty((0, dim)), np.empty((0, dim))),
+        return cls(Interval.trusted(np.empty((0, dim)), np.empty((0, dim))),
                    np.zeros(0, dtype=bool))
 
     def sorted(self) -> Subpaving:
@@ -301,7 +301,7 @@ class Subpaving:
         """Interval hull of the inside and boundary boxes, shape ``(n,)`` (empty when none)."""
         if len(self) == 0:
             return Interval.empty(self.dim)
-        return Interval._new(self.boxes.lo.min(axis=0), self.boxes.hi.max(axis=0))
+        return Interval.trusted(self.boxes.lo.min(axis=0), self.boxes.hi.max(axis=0))
 
     def volume_inner(self) -> float:
         """Total volume of the inside boxes, rounded downward (a lower bound of the set's)."""
@@ -372,8 +372,8 @@ class Subpaving:
             olo = np.maximum(self.outside.lo, other.lo)
             ohi = np.minimum(self.outside.hi, other.hi)
             okeep = np.all(olo <= ohi, axis=1)
-            return Subpaving(Interval._new(lo[keep], hi[keep]), self.inside[keep],
-                             Interval._new(olo[okeep], ohi[okeep]))
+            return Subpaving(Interval.trusted(lo[keep], hi[keep]), self.inside[keep],
+                             Interval.trusted(olo[okeep], ohi[okeep]))
         if not isinstance(other, Subpaving):
             raise ValueError(f"intersect needs a box or a Subpaving, got {type(other).__name__}")
         self._check_dim(other.dim, "the other subpaving")
@@ -390,9 +390,9 @@ class Subpaving:
             drop = np.zeros(lo.shape[0], dtype=bool)
             drop[np.flatnonzero(flat)[fi[inner]]] = True
             lo, hi, ins = lo[~drop], hi[~drop], ins[~drop]
-        outside = Interval._new(np.concatenate([self.outside.lo, other.outside.lo]),
+        outside = Interval.trusted(np.concatenate([self.outside.lo, other.outside.lo]),
                                 np.concatenate([self.outside.hi, other.outside.hi]))
-        return Subpaving(Interval._new(lo, hi), ins, outside)
+        return Subpaving(Interval.trusted(lo, hi), ins, outside)
 
     def union(self, other: Subpaving) -> Subpaving:
         """The union (boxes of ``other`` are cut so that interiors stay disjoint).
@@ -417,5 +417,5 @@ class Subpaving:
         ins[:ilo.shape[0]] = True
         so, oo = self.outside, other.outside
         i, j = pairs(so.lo, so.hi, oo.lo, oo.hi, strict=True)
-        outside = Interval._new(np.maximum(so.lo[i], oo.lo[j]), np.minimum(so.hi[i], oo.hi[j]))
-        return Subpaving(Interval._new(lo, hi), ins, outside)
+        outside = Interval.trusted(np.maximum(so.lo[i], oo.lo[j]), np.minimum(so.hi[i], oo.hi[j]))
+        return Subpaving(Interval.trusted(lo, hi), ins, outside)

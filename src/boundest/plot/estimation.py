@@ -149,7 +149,7 @@ def plot_set_sequence(rows: Sequence[Sequence[Interval | Subpaving]],
         else:
             mid = (h.lo + h.hi) / 2
             half = max(float(np.max(h.hi - h.lo)) / 2 * 1.3, 0.02 * span)
-            view = Interval._new(np.maximum(mid - half, fl), np.minimum(mid + half, fh))
+            view = Interval.trusted(np.maximum(mid - half, fl), np.minimum(mid + half, fh))
         for r, row in enumerate(rows):
             style = SET_STYLES[1 if r == len(rows) - 1 else (0 if r == 0 else 2)]
             if k < len(row):

@@ -41,7 +41,7 @@ def ping_consistency(data: PoolData, res: PoolResult) -> NDArray[np.bool_]:
     b, d = res.boxes, data.ranges
     beta_lo, beta_hi = b.lo[:, 2] + data.alpha, b.hi[:, 2] + data.alpha
     with np.errstate(invalid="ignore"):
-        box = Interval._new(np.stack([b.lo[:, 0], b.lo[:, 1], np.nextafter(beta_lo, -np.inf),
+        box = Interval.trusted(np.stack([b.lo[:, 0], b.lo[:, 1], np.nextafter(beta_lo, -np.inf),
                                       d.lo], -1),
                             np.stack([b.hi[:, 0], b.hi[:, 1], np.nextafter(beta_hi, np.inf),
                                       d.hi], -1))

@@ -128,7 +128,7 @@ def plot_clock_drift(res: ClockResult, truth: ClockTruth | None = None,
                         truth_color="black", label="tube [h](t)",
                         truth_label="true drift (simulation)")
     tau = res.meas.tau
-    eps = Interval._new(tau.lo - 0.08, tau.hi + 0.08)
+    eps = Interval.trusted(tau.lo - 0.08, tau.hi + 0.08)
     artists.append(plot_boxes(res.t_initial, eps, ax=ax, facecolor="tab:blue",
                               edgecolor="navy", alpha=0.35,
                               label="[t_i] at clock time tau_i, from the drift bounds"))

@@ -249,7 +249,7 @@ def check_sorted(table: Table, column: str, strict: bool) -> None:
 
 def outward(lo: NDArray, hi: NDArray) -> Interval:
     """One ulp outward: encloses the decimal numbers that ``lo``, ``hi`` were parsed from."""
-    return Interval._new(np.nextafter(lo, -np.inf), np.nextafter(hi, np.inf))
+    return Interval.trusted(np.nextafter(lo, -np.inf), np.nextafter(hi, np.inf))
 
 
 def sample_index(table: Table, t0: float, dt: float, n: int, column: str = "t"

@@ -41,7 +41,7 @@ __all__ = ["AuvResult", "CtcDetections", "detection_constraints", "localize", "s
 
 # -- the world velocity R v ------------------------------------------------------------------
 def _stack(parts: list[Interval]) -> Interval:
-    return Interval._new(np.stack([q.lo for q in parts], axis=-1),
+    return Interval.trusted(np.stack([q.lo for q in parts], axis=-1),
                          np.stack([q.hi for q in parts], axis=-1))
 
 
@@ -82,7 +82,7 @@ def world_velocity(attitude: Interval, velocity: Interval, form: str = "best") -
     if n > _CHUNK:  # bounded memory: some 70 temporaries per sample
         parts = [_world_velocity(attitude[i:i + _CHUNK], velocity[i:i + _CHUNK], form)
                  for i in range(0, n, _CHUNK)]
-        return Interval._new(np.concatenate([q.lo for q in parts]),
+        return Interval.trusted(np.concatenate([q.lo for q in parts]),
                              np.concatenate([q.hi for q in parts]))
     return _world_velocity(attitude, velocity, form)
 
@@ -218,14 +218,14 @@ class CtcDetections:
                  mines: Interval) -> None:
         k, nd, per = self.k, self.k.size, self.per
         lo, hi = self.tape.lo.copy(), self.tape.hi.copy()
-        rows = Interval._new(lo[: per * nd].reshape(nd, per), hi[: per * nd].reshape(nd, per))
+        rows = Interval.trusted(lo[: per * nd].reshape(nd, per), hi[: per * nd].reshape(nd, per))
         for cols, dom in ((slice(0, 3), p.gates[k]), (slice(3, 6), attitude[k]),
                           (slice(6, 7), altitude[k][:, None])):
             cut = rows[:, cols] & dom
             rows.lo[:, cols], rows.hi[:, cols] = cut.lo, cut.hi
         lo[: per * nd], hi[: per * nd] = rows.lo.ravel(), rows.hi.ravel()
         mv = slice(per * nd, self.n_vars)
-        m = Interval._new(lo[mv], hi[mv]) & mines.reshape(-1)
+        m = Interval.trusted(lo[mv], hi[mv]) & mines.reshape(-1)
         lo[mv], hi[mv] = m.lo, m.hi
         res = propagate(replace(self.tape, lo=lo, hi=hi), rel_eps=self.rel_eps, progress=False,
                         mode="hc4")
@@ -235,7 +235,7 @@ class CtcDetections:
                 dom.lo[...] = dom.hi[...] = np.nan
             return
         out = res.slots
-        rows = Interval._new(out.lo[: per * nd].reshape(nd, per),
+        rows = Interval.trusted(out.lo[: per * nd].reshape(nd, per),
                              out.hi[: per * nd].reshape(nd, per))
         p.gates[k] = rows[:, 0:3]
         attitude[k] = rows[:, 3:6]
@@ -300,7 +300,7 @@ def position_tube(data: AuvData) -> Tube:
     GPS boxes at the fixes, the depth boxes on every gate, ``p_z >= 0`` everywhere."""
     n = data.n
     t = np.arange(n, dtype=np.float64)
-    slices = Interval._new(np.tile([-np.inf, -np.inf, 0.0], (n - 1, 1)),
+    slices = Interval.trusted(np.tile([-np.inf, -np.inf, 0.0], (n - 1, 1)),
                            np.full((n - 1, 3), np.inf))
     x = Tube(t, slices)
     x.gates.lo[:, 2] = np.maximum(x.gates.lo[:, 2], data.depth.lo)

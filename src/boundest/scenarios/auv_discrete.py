@@ -148,9 +148,9 @@ def solve_discrete(data: AuvData, slam: bool = True, rel_eps: float = 1e-6,
     res = propagate(tape, rel_eps=rel_eps, progress=progress, mode="hc4")
     n = data.n
     s = res.slots
-    pos = Interval._new(s.lo[: 3 * n].reshape(n, 3), s.hi[: 3 * n].reshape(n, 3))
+    pos = Interval.trusted(s.lo[: 3 * n].reshape(n, 3), s.hi[: 3 * n].reshape(n, 3))
     m0 = 10 * n
-    mines = Interval._new(s.lo[m0: m0 + 3 * data.n_mines].reshape(-1, 3),
+    mines = Interval.trusted(s.lo[m0: m0 + 3 * data.n_mines].reshape(-1, 3),
                           s.hi[m0: m0 + 3 * data.n_mines].reshape(-1, 3))
     if not slam:
         mines = Interval.entire((data.n_mines, 3))

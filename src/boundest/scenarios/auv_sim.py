@@ -162,7 +162,7 @@ def _boxes(truth: NDArray, error: NDArray, half: float | NDArray, what: str) -> 
     """``truth + error +- half``, checked to contain the truth."""
     _check(bool(np.all(np.abs(error) <= MAX_ERROR * half)), f"{what} error above the bound")
     mid = truth + error
-    box = Interval._new(mid - half, mid + half)
+    box = Interval.trusted(mid - half, mid + half)
     _check(bool(np.all(box.contains(truth))), f"a {what} box misses the truth")
     return box
 
@@ -403,7 +403,7 @@ def simulate_survey(seed: int = 0, n_samples: int = 6000, dt: float = 0.1, t0: f
     fix_k = np.array([0, n - 1], dtype=np.intp)
     gps_err = h["gps"] * rng.uniform(-0.8, 0.8, size=(2, 2))
     fix_h = _boxes(p[fix_k, :2], gps_err, h["gps"], "GPS")
-    fix = Interval._new(np.column_stack([fix_h.lo, np.full(2, _SURFACE[0])]),
+    fix = Interval.trusted(np.column_stack([fix_h.lo, np.full(2, _SURFACE[0])]),
                         np.column_stack([fix_h.hi, np.full(2, _SURFACE[1])]))
     r_err = h["range"] * (_bias(rng, 0.05, 0.3)
                           + rng.uniform(-0.3, 0.3, size=det_k.size))

@@ -105,8 +105,8 @@ def load(path: str | Path | None = None) -> ClockMeasurements:
             raise cols.error(k, f"{name} = {float(cols[name][k])!r} is negative")
     check_index(cols, "i", 1)
     check_sorted(cols, "tau", strict=True)
-    tau = Interval._new(np.nextafter(cols["tau"], -np.inf), np.nextafter(cols["tau"], np.inf))
-    z = Interval._new(np.nextafter(cols["z_lo"], -np.inf), np.nextafter(cols["z_hi"], np.inf))
+    tau = Interval.trusted(np.nextafter(cols["tau"], -np.inf), np.nextafter(cols["tau"], np.inf))
+    z = Interval.trusted(np.nextafter(cols["z_lo"], -np.inf), np.nextafter(cols["z_hi"], np.inf))
     return ClockMeasurements(tau, z, str(path))
 
 
@@ -201,7 +201,7 @@ def simulate(seed: int | None = 0, n: int = 8, period: float = 1.5, z_width: flo
 
 # -- the constraint network -----------------------------------------------------------------
 def _box(*comps: Interval) -> Interval:
-    return Interval._new(np.stack([c.lo for c in comps], axis=-1),
+    return Interval.trusted(np.stack([c.lo for c in comps], axis=-1),
                          np.stack([c.hi for c in comps], axis=-1))
 
 
@@ -283,7 +283,7 @@ class ClockResult:
 
 def _item(a: Interval, i: int) -> Interval:
     """Element ``i`` of a 1-D interval array as a 0-d view (contracting it writes into ``a``)."""
-    return Interval._new(a.lo[i, ...], a.hi[i, ...])
+    return Interval.trusted(a.lo[i, ...], a.hi[i, ...])
 
 
 def solve(meas: ClockMeasurements | None = None, dt: float = 0.01, tf: float | None = None,
@@ -316,16 +316,16 @@ def solve(meas: ClockMeasurements | None = None, dt: float = 0.01, tf: float | N
     n = t.size - 1
     h = Tube(t, Interval.entire(n))
     h.gates[0] = Interval(0.0)
-    y = Tube(t, Interval._new(np.full(n, DEPTH), np.full(n, np.inf)))
+    y = Tube(t, Interval.trusted(np.full(n, DEPTH), np.full(n, np.inf)))
     w = Tube(t, Interval.entire(n))
     x1, x2, v1, v2, yv, wv = (Var(s) for s in ("x1", "x2", "v1", "v2", "y", "w"))
     distance = CtcSlices([yv == ef.sqrt(ef.sqr(x1) + ef.sqr(x2) + DEPTH**2),
                           wv == (x1 * v1 + x2 * v2) / yv], ["x1", "x2", "v1", "v2", "y", "w"])
-    t_i = Interval._new(np.zeros(len(meas)), np.full(len(meas), tf))
+    t_i = Interval.trusted(np.zeros(len(meas)), np.full(len(meas), tf))
     z = meas.z.copy()
     deriv, ev = CtcDeriv(), CtcEval(time_deriv)
     deriv.contract(h, phi)
-    t_initial = Interval._new(*np.array([[float(r.lo), float(r.hi)] for r in
+    t_initial = Interval.trusted(*np.array([[float(r.lo), float(r.hi)] for r in
                                          (h.inverse(meas.tau[i], hull=True)
                                           for i in range(len(meas)))]).T)
     cn = ContractorNetwork()

@@ -175,7 +175,7 @@ class PoolObserver:
             self.x0.lo, self.x0.hi, self.restart.lo, self.restart.hi, self.h[0], self.h[1],
             self.tapes, self.bank, xl, xh, self.work, self.cells[0], self.cells[1])
         self.k += 1
-        return Interval._new(xl, xh), int(rej), bool(empty)
+        return Interval.trusted(xl, xh), int(rej), bool(empty)
 
 
 @dataclass(repr=False)
@@ -272,6 +272,6 @@ def solve_pool(data: PoolData, q: int = 8, m: int = 80, sweeps: int = DEFAULT_SW
     if not batch:
         xl, xh, rejected, empty, cells, cl, ch = (xl[0], xh[0], rejected[0], empty[0],
                                                   cells[0], cl[0], ch[0])
-    return PoolResult(Interval._new(xl, xh), rejected, empty, probs, q, m, elapsed, cells,
-                      Interval._new(cl, ch) if paved else None,
+    return PoolResult(Interval.trusted(xl, xh), rejected, empty, probs, q, m, elapsed, cells,
+                      Interval.trusted(cl, ch) if paved else None,
                       (paving, paving_heading) if paved else None)

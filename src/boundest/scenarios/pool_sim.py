@@ -214,7 +214,7 @@ def simulate_pool(seed: int = 0, n_missions: int | None = None, p_outlier: float
         if k + 1 < n:
             states[:, k + 1] = euler_step(X, command[:, k] + bias + noise[:, k], dt)
     u_true = command + bias[:, None, :] + noise
-    u_box = Interval._new(command - INPUT_HALF_WIDTH, command + INPUT_HALF_WIDTH)
+    u_box = Interval.trusted(command - INPUT_HALF_WIDTH, command + INPUT_HALF_WIDTH)
     _check(bool(np.all(u_box.contains(u_true))), "an input box misses the true input")
     _check(bool(np.all(_in_free_space(pool, states[..., :2]))),
            "the robot left the free space of the pool")
@@ -229,10 +229,10 @@ def simulate_pool(seed: int = 0, n_missions: int | None = None, p_outlier: float
     # noise in (-0.1, 0.1), a hair inside so that the float box surely contains the truth
     e = RANGE_HALF_WIDTH * (1 - 1e-9) * (2 * _uniform(seeds, 5, n) - 1)
     reading = np.where(outlier, wrong[:, None], distance) + e
-    ranges = Interval._new(reading - RANGE_HALF_WIDTH, reading + RANGE_HALF_WIDTH)
+    ranges = Interval.trusted(reading - RANGE_HALF_WIDTH, reading + RANGE_HALF_WIDTH)
     _check(bool(np.all(ranges.contains(distance)[~outlier])), "an inlier box misses the truth")
 
-    x0_box = Interval._new(np.nextafter(x0_lo, -np.inf), np.nextafter(x0_hi, np.inf))
+    x0_box = Interval.trusted(np.nextafter(x0_lo, -np.inf), np.nextafter(x0_hi, np.inf))
     sonar = setup["sonar"]
     data = PoolData(t0=float(t0), dt=float(dt), inputs=u_box, alpha=alpha, ranges=ranges,
                     x0=x0_box, map=pool, p_outlier=float(p_outlier),

@@ -144,7 +144,7 @@ def load(path: str | Path | None = None, beacons: str | Path | None = None,
                             f"{float(th[j])!r}] repeats line {int(cols.lines[j - 1])} (the same "
                             "measurement twice)")
     t = outward(cols["t_lo"], cols["t_hi"])
-    t = Interval._new(np.maximum(t.lo, domain[0]), np.minimum(t.hi, domain[1]))
+    t = Interval.trusted(np.maximum(t.lo, domain[0]), np.minimum(t.hi, domain[1]))
     z = outward(cols["z_lo"], cols["z_hi"])
     bxy = np.stack([bcols["bx"], bcols["by"]], axis=1)
     return Measurements(t, z, beacon, outward(bxy, bxy), list(names),
@@ -249,7 +249,8 @@ def input_tube(t: NDArray[np.float64]) -> Tube:
         e = Interval(-U_BOUND, U_BOUND)
         u1 = -(Interval(9.0) / 20) * iv.cos(s / 5) + e
         u2 = Interval(1.0) / 10 + iv.sin(s / 4) + e
-        return Interval._new(np.stack([u1.lo, u2.lo], axis=-1), np.stack([u1.hi, u2.hi], axis=-1))
+        return Interval.trusted(np.stack([u1.lo, u2.lo], axis=-1),
+                                np.stack([u1.hi, u2.hi], axis=-1))
     return Tube.from_function_on(t, f)
 
 
@@ -340,7 +341,7 @@ class RangeOnlyResult:
 
 def _item(a: Interval, i: int) -> Interval:
     """Element ``i`` of a 1-D interval array as a 0-d view (contracting it writes into ``a``)."""
-    return Interval._new(a.lo[i, ...], a.hi[i, ...])
+    return Interval.trusted(a.lo[i, ...], a.hi[i, ...])
 
 
 @dataclass
@@ -365,7 +366,7 @@ def _network(meas: Measurements, t: NDArray[np.float64], time_deriv: bool = Fals
              rate: str = "both") -> _Network:
     n_b = meas.beacons.shape[0]
     full = Interval.entire(4)
-    x = Tube(t, Interval._new(np.broadcast_to(full.lo, (t.size - 1, 4)).copy(),
+    x = Tube(t, Interval.trusted(np.broadcast_to(full.lo, (t.size - 1, 4)).copy(),
                               np.broadcast_to(full.hi, (t.size - 1, 4)).copy()))
     x3_0, x4_0 = initial_heading_speed()
     x.gates[0, 2] = x3_0
@@ -373,7 +374,7 @@ def _network(meas: Measurements, t: NDArray[np.float64], time_deriv: bool = Fals
     v = x.copy()
     v.gates[0] = Interval.entire(4)
     u = input_tube(t)
-    y = Tube(t, Interval._new(np.zeros((t.size - 1, n_b)), np.full((t.size - 1, n_b), np.inf)))
+    y = Tube(t, Interval.trusted(np.zeros((t.size - 1, n_b)), np.full((t.size - 1, n_b), np.inf)))
     w = Tube(t, Interval.entire((t.size - 1, n_b)))
     x1, x2, x3, x4 = (Var(f"x{j}") for j in range(1, 5))
     v1, v2, v3, v4, u1, u2, yk, wk = (Var(n) for n in ("v1", "v2", "v3", "v4", "u1", "u2",

@@ -268,7 +268,7 @@ class SatelliteResult:
                 "x_hi": rows(self.x_hi)}
 
     def box(self, k: int) -> Interval:
-        return Interval._new(self.x_lo[k], self.x_hi[k])
+        return Interval.trusted(self.x_lo[k], self.x_hi[k])
 
     def __repr__(self) -> str:
         """Counts and mean widths, not the enclosures (``x_lo``, ``x_hi`` hold them)."""

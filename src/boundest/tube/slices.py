@@ -79,7 +79,7 @@ class CtcSlices:
         # one batch: the n slices, then the n + 1 gates
         lo = np.concatenate([_rows(d, n, "lo") for d in domains], axis=1)
         hi = np.concatenate([_rows(d, n, "hi") for d in domains], axis=1)
-        out = self.ctc.contract(Interval._new(lo, hi))
+        out = self.ctc.contract(Interval.trusted(lo, hi))
         if np.isnan(out.lo).any():
             _empty_all(domains)
             return

@@ -131,9 +131,9 @@ class Tube:
                 gates = intersect(gates, _default_gates(slices))
         self.t = t
         self.continuous = bool(continuous)
-        self.slices = Interval._new(np.array(slices.lo, dtype=np.float64),
+        self.slices = Interval.trusted(np.array(slices.lo, dtype=np.float64),
                                     np.array(slices.hi, dtype=np.float64))
-        self.gates = Interval._new(np.array(gates.lo, dtype=np.float64),
+        self.gates = Interval.trusted(np.array(gates.lo, dtype=np.float64),
                                    np.array(gates.hi, dtype=np.float64))
         self._normalize_empty()
 
@@ -156,9 +156,9 @@ class Tube:
         if v.ndim > 1:
             raise ValueError(f"a constant tube takes an interval or a box, got shape {v.shape}")
         n = t.size - 1
-        slices = Interval._new(np.broadcast_to(v.lo, (n, *v.shape)).copy(),
+        slices = Interval.trusted(np.broadcast_to(v.lo, (n, *v.shape)).copy(),
                                np.broadcast_to(v.hi, (n, *v.shape)).copy())
-        gates = Interval._new(np.broadcast_to(v.lo, (n + 1, *v.shape)).copy(),
+        gates = Interval.trusted(np.broadcast_to(v.lo, (n + 1, *v.shape)).copy(),
                               np.broadcast_to(v.hi, (n + 1, *v.shape)).copy())
         return cls._wrap(t, slices, gates)._normalize_empty()
 
@@ -201,8 +201,8 @@ class Tube:
     def from_function_on(cls, t: ArrayLike, f: Callable[[Interval], Interval]) -> Tube:
         """As :meth:`from_function` on given gate times ``t``."""
         t = _check_times(t)
-        slices = as_interval(f(Interval._new(t[:-1], t[1:])))
-        gates = as_interval(f(Interval._new(t, t)))
+        slices = as_interval(f(Interval.trusted(t[:-1], t[1:])))
+        gates = as_interval(f(Interval.trusted(t, t)))
         n = t.size - 1
         if slices.shape[:1] != (n,) or gates.shape != (n + 1, *slices.shape[1:]):
             raise ValueError(f"f must map an Interval of shape (m,) to shape (m,) or (m, d); "
@@ -231,7 +231,7 @@ class Tube:
         r = np.asarray(inflation, dtype=np.float64)
         if np.any(~np.isfinite(r)) or np.any(r < 0):
             raise ValueError(f"inflation must be finite and non-negative, got {inflation!r}")
-        gates = Interval._new(y, y).inflate(r)
+        gates = Interval.trusted(y, y).inflate(r)
         slices = hull(gates[:-1], gates[1:])
         return cls(t, slices, gates)
 
@@ -297,9 +297,9 @@ class Tube:
         for k, y in enumerate(tubes):
             if y.is_vector or not _same_grid(t, y.t):
                 raise ValueError(f"stack: tube {k} is not a scalar tube on the same gate times")
-        s = Interval._new(np.stack([y.slices.lo for y in tubes], axis=1),
+        s = Interval.trusted(np.stack([y.slices.lo for y in tubes], axis=1),
                           np.stack([y.slices.hi for y in tubes], axis=1))
-        g = Interval._new(np.stack([y.gates.lo for y in tubes], axis=1),
+        g = Interval.trusted(np.stack([y.gates.lo for y in tubes], axis=1),
                           np.stack([y.gates.hi for y in tubes], axis=1))
         cont = all(y.continuous for y in tubes)
         return Tube._wrap(t.copy(), s, g, cont)._normalize_empty()
@@ -338,7 +338,7 @@ class Tube:
         use_gate = at_gate | at_end
         lo = np.where(_col(use_gate, self), self.gates.lo[gi], self.slices.lo[i])
         hi = np.where(_col(use_gate, self), self.gates.hi[gi], self.slices.hi[i])
-        return Interval._new(lo, hi)
+        return Interval.trusted(lo, hi)
 
     def _eval_interval(self, a: float, b: float) -> Interval:
         """Hull of the slices meeting ``]a, b[`` and of the gates in ``[a, b]``."""
@@ -353,7 +353,7 @@ class Tube:
                                                                    initial=-np.inf))
         if self.is_empty():
             lo, hi = lo * np.nan, hi * np.nan
-        return Interval._new(lo, hi)
+        return Interval.trusted(lo, hi)
 
     def slice_range(self, a: float, b: float) -> tuple[int, int]:
         """Indices ``i0, i1`` such that slices ``i0 .. i1-1`` are those whose open time
@@ -379,7 +379,7 @@ class Tube:
                      for a, b in zip(t.lo.ravel(), t.hi.ravel(), strict=True)]
             lo = np.array([p.lo for p in parts]).reshape(*t.shape, *self.slices.shape[1:])
             hi = np.array([p.hi for p in parts]).reshape(*t.shape, *self.slices.shape[1:])
-            return Interval._new(lo, hi)
+            return Interval.trusted(lo, hi)
         s = np.asarray(t, dtype=np.float64)
         self._check_in_domain(s, s)
         out = self._eval_points(s.ravel())
@@ -482,7 +482,7 @@ class Tube:
                                (float(b.lo), float(b.hi))) for j in range(lo2.shape[1])]
         lo = np.array([o[0] for o in out]).reshape(shape)
         hi = np.array([o[1] for o in out]).reshape(shape)
-        return Interval._new(lo, hi)
+        return Interval.trusted(lo, hi)
 
     def primitive(self, x0: Interval | ArrayLike = 0.0) -> Tube:
         """The tube of ``x0 + ∫_{t0}^{t} y(s) ds`` (outward-rounded cumulative sums)."""
@@ -491,15 +491,15 @@ class Tube:
         lo2 = self.slices.lo.reshape(n, -1)
         hi2 = self.slices.hi.reshape(n, -1)
         d = lo2.shape[1]
-        x0 = Interval._new(np.broadcast_to(x0.lo, (d,)), np.broadcast_to(x0.hi, (d,)))
+        x0 = Interval.trusted(np.broadcast_to(x0.lo, (d,)), np.broadcast_to(x0.hi, (d,)))
         cols = [primitive_gates(self.t, lo2[:, [j]], hi2[:, [j]], float(x0.lo[j]),
                                 float(x0.hi[j])) for j in range(d)]
         glo, ghi, slo, shi = (np.concatenate([c[k] for c in cols], axis=1) for k in range(4))
         shape = self.slices.shape[1:]
         # a primitive is continuous whether or not the integrand jumps
-        out = Tube._wrap(self.t.copy(), Interval._new(slo.reshape(n, *shape),
+        out = Tube._wrap(self.t.copy(), Interval.trusted(slo.reshape(n, *shape),
                                                       shi.reshape(n, *shape)),
-                         Interval._new(glo.reshape(n + 1, *shape), ghi.reshape(n + 1, *shape)))
+                         Interval.trusted(glo.reshape(n + 1, *shape), ghi.reshape(n + 1, *shape)))
         if self.is_empty() or np.any(x0.is_empty()):
             out.set_empty()
         return out
@@ -641,7 +641,7 @@ def _default_gates(slices: Interval) -> Interval:
     """Gates enclosed by both neighbouring slices."""
     first, last = slices[:1], slices[-1:]
     inner = intersect(slices[:-1], slices[1:])
-    return Interval._new(np.concatenate([first.lo, inner.lo, last.lo]),
+    return Interval.trusted(np.concatenate([first.lo, inner.lo, last.lo]),
                          np.concatenate([first.hi, inner.hi, last.hi]))
 
 
@@ -649,7 +649,7 @@ def _hull_gates(slices: Interval) -> Interval:
     """Gates of a tube with jumps: the hull of the neighbouring slices."""
     first, last = slices[:1], slices[-1:]
     inner = hull(slices[:-1], slices[1:])
-    return Interval._new(np.concatenate([first.lo, inner.lo, last.lo]),
+    return Interval.trusted(np.concatenate([first.lo, inner.lo, last.lo]),
                          np.concatenate([first.hi, inner.hi, last.hi]))
 
 
