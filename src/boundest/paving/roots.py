@@ -118,7 +118,7 @@ class _Shaving:
             self.probes += int(self.stats[1])
             out_lo[i] = np.maximum(x.lo[i], lo[self.slots])
             out_hi[i] = np.minimum(x.hi[i], hi[self.slots])
-        return Interval._new(out_lo, out_hi)
+        return Interval.trusted(out_lo, out_hi)
 
 
 #: shave_kernel's settings: rel_eps, probe_eps, probe_evals, frac, max_rounds, reach, min_gain,
@@ -159,7 +159,7 @@ def _contract(newton: CtcNewton, prop: _Shaving, x: Interval, rounds: int,
         idx = np.flatnonzero(active)
         if not len(idx):
             break
-        xa = Interval._new(lo[idx], hi[idx])
+        xa = Interval.trusted(lo[idx], hi[idx])
         before = xa.width().max(axis=-1)
         y = prop(xa, shave[idx])
         alive = _nonempty(y)
@@ -169,7 +169,7 @@ def _contract(newton: CtcNewton, prop: _Shaving, x: Interval, rounds: int,
         zl[~alive] = zh[~alive] = np.nan
         sel = np.flatnonzero(alive)
         if len(sel):
-            z0 = Interval._new(zl[sel], zh[sel])
+            z0 = Interval.trusted(zl[sel], zh[sel])
             z, p = newton.prove(z0)
             calls += len(sel)
             zl[sel], zh[sel] = z.lo, z.hi
@@ -180,7 +180,7 @@ def _contract(newton: CtcNewton, prop: _Shaving, x: Interval, rounds: int,
         after = np.where(alive, np.nan_to_num(zh - zl, nan=0.0).max(axis=-1), 0.0)
         with np.errstate(invalid="ignore"):
             active[idx] = alive & (after < 0.9 * before) & ~proved[idx]
-    out = Interval._new(lo, hi)
+    out = Interval.trusted(lo, hi)
     return out, proved & _nonempty(out), calls
 
 
@@ -195,7 +195,7 @@ def _polish(newton: CtcNewton, x: Interval, rounds: int = 4) -> tuple[Interval, 
         y, _ = newton.prove(x)
         calls += len(x)
         ok = _nonempty(y)  # a proved box is never emptied; keep x where rounding says so
-        y = Interval._new(np.where(ok[:, None], y.lo, x.lo), np.where(ok[:, None], y.hi, x.hi))
+        y = Interval.trusted(np.where(ok[:, None], y.lo, x.lo), np.where(ok[:, None], y.hi, x.hi))
         shrunk = y.width().max(axis=-1) < 0.5 * x.width().max(axis=-1)
         x = y
         if not shrunk.any():
@@ -253,7 +253,7 @@ def _bisect(tape: FunctionTape, x: Interval, eps: float
     llo, lhi, rlo, rhi = x.lo[ok], x.hi[ok].copy(), x.lo[ok].copy(), x.hi[ok]
     lhi[np.arange(len(k)), axis] = p[k, axis]
     rlo[np.arange(len(k)), axis] = p[k, axis]
-    return Interval._new(np.concatenate([llo, rlo]), np.concatenate([lhi, rhi])), ok
+    return Interval.trusted(np.concatenate([llo, rlo]), np.concatenate([lhi, rhi])), ok
 
 
 def _inside(model: Model, names: list[str], domains: Interval
