@@ -261,8 +261,8 @@ def _centered_kernel(op, out, a, b, param, node_ptr, out_slot, row_ptr, cols, sl
                 sl[o], sh[o] = max(sl[o], tl[bx, k]), min(sh[o], th[bx, k])
                 if not sl[o] <= sh[o]:
                     empty = True
-            if not empty and revise_nodes(op, out, a, b, param, sl, sh, buf, True, piecewise,
-                                          pown, explog, trig):
+            if not empty and revise_nodes(op, out, a, b, param, sl, sh, buf, np.int64(1),
+                                          piecewise, pown, explog, trig):
                 for j in range(n):
                     xl[bx, j] = max(xl[bx, j], sl[j])
                     xh[bx, j] = min(xh[bx, j], sh[j])

@@ -251,17 +251,20 @@ def hc4_pass(op, out, a, b, param, lo, hi, buf, piecewise, pown, explog, trig):
     slot only shrinks and holds every solution it held. Returns False as soon as a slot becomes
     empty (the slots are then partly updated: the box has no solution), True otherwise.
     """
-    return (revise_nodes(op, out, a, b, param, lo, hi, buf, False, piecewise, pown, explog,
-                         trig)
-            and revise_nodes(op, out, a, b, param, lo, hi, buf, True, piecewise, pown, explog,
-                             trig))
+    # the direction as an int64 value, not a bool literal: Numba would compile revise_nodes
+    # once per literal (test_compile_once)
+    return (revise_nodes(op, out, a, b, param, lo, hi, buf, np.int64(0), piecewise, pown,
+                         explog, trig)
+            and revise_nodes(op, out, a, b, param, lo, hi, buf, np.int64(1), piecewise, pown,
+                             explog, trig))
 
 
 @nb.njit(cache=True, error_model="numpy")
 def revise_nodes(op, out, a, b, param, lo, hi, buf, backward, piecewise, pown, explog, trig):
-    """Revise every node of a tape once, in tape order (last to first with ``backward``: the
-    backward half of :func:`hc4_pass`, which is all a pass needs when the slots already hold
-    the forward images); returns False as soon as a slot becomes empty."""
+    """Revise every node of a tape once, in tape order (last to first when the int64
+    ``backward`` is nonzero: the backward half of :func:`hc4_pass`, which is all a pass needs
+    when the slots already hold the forward images); returns False as soon as a slot becomes
+    empty."""
     n = op.size
     for step in range(n):
         i = n - 1 - step if backward else step
