@@ -304,6 +304,8 @@ def contract_rows(al, ah, rl, rh, dl, dh, reverse, work):
         i = m - 1 - step if reverse else step
         for j in range(n):
             tl[j], th[j] = _term(al[i, j], ah[i, j], dl[j], dh[j])
+        if _inactive(tl, th, rl[i], rh[i], n):
+            continue
         pl[0] = ph[0] = 0.0
         for j in range(n):
             pl[j + 1] = _nan_lo(add_dn(pl[j], tl[j]))
@@ -324,7 +326,9 @@ def contract_rows(al, ah, rl, rh, dl, dh, reverse, work):
             oh = _nan_hi(add_up(ph[j], qh[j + 1]))
             nl = _nan_lo(_sub_lo(rl[i], rh[i], ol, oh))
             nh = _nan_hi(_sub_hi(rl[i], rh[i], ol, oh))
-            if nl == -INF and nh == INF:
+            if nl <= tl[j] and th[j] <= nh:
+                # a_j d_j already lies in N: every (a, d) of the domains satisfies the row, so
+                # relational division contracts nothing (exactly; it would round outward)
                 pl[j + 1] = _nan_lo(add_dn(pl[j], tl[j]))
                 ph[j + 1] = _nan_hi(add_up(ph[j], th[j]))
                 continue
@@ -337,6 +341,25 @@ def contract_rows(al, ah, rl, rh, dl, dh, reverse, work):
             pl[j + 1] = _nan_lo(add_dn(pl[j], tl[j]))
             ph[j + 1] = _nan_hi(add_up(ph[j], th[j]))
     return True
+
+
+@nb.njit(cache=True, inline="always", error_model="numpy")
+def _inactive(tl, th, rl, rh, n):
+    """Whether a row whose terms are ``[tl_j, th_j]`` contracts nothing: every term lies in
+    ``r`` minus the sum of the others, i.e. ``rl <= S_hi - w`` and ``S_lo + w <= rh`` for the
+    sums ``S`` of the terms and their largest width ``w`` (so the row's range meets ``r`` as
+    well). Decided in round-to-nearest, true only with a margin above the rounding errors of
+    the sums (Higham's ``gamma_n`` bound, doubled, and an underflow floor): then the outward
+    rounded row sweep of :func:`contract_rows` would skip every term too, so skipping the row
+    changes no bit. False (do the sweep) when unsure, and for infinite terms or targets."""
+    sl = sh = mag = w = 0.0
+    for j in range(n):
+        sl += tl[j]
+        sh += th[j]
+        mag += abs(tl[j]) + abs(th[j])
+        w = max(w, th[j] - tl[j])
+    e = (n + 4) * (2.0**-52 * (mag + abs(rl) + abs(rh)) + 2.0**-1074)
+    return (sh - w) - rl >= e and rh - (sl + w) >= e
 
 
 @nb.njit(cache=True, inline="always", error_model="numpy")
