@@ -67,7 +67,7 @@ from .revise import (
     TAN,
     TANH,
     family_flags,
-    revise,
+    image,
 )
 
 __all__ = ["centered", "evaluate", "forward_jacobian", "jacobian", "jacobian_sparse"]
@@ -281,9 +281,8 @@ def forward_pass(op, out, a, b, param, lo, hi, buf, piecewise, pown, explog, tri
     for i in range(op.size):
         ib = b[i]
         yl, yh = (lo[ib], hi[ib]) if ib >= 0 else (0.0, 0.0)
-        zl, zh, _, _, _, _ = revise(op[i], -INF, INF, lo[a[i]], hi[a[i]], yl, yh, param[i], buf,
-                                    piecewise, pown, explog, trig)
-        lo[out[i]], hi[out[i]] = zl, zh
+        lo[out[i]], hi[out[i]] = image(op[i], lo[a[i]], hi[a[i]], yl, yh, param[i], buf,
+                                       piecewise, pown, explog, trig)
 
 
 @_njit

@@ -21,8 +21,10 @@ from ..interval import arith as ar
 from ..interval import explog as el
 from ..interval import trig as tr
 
-__all__ = ["FAMILIES", "OP_CODES", "family_flags", "hc4_pass", "revise", "revise_nodes"]
+__all__ = ["FAMILIES", "OP_CODES", "back", "family_flags", "hc4_pass", "image", "revise",
+           "revise_nodes"]
 
+INF = math.inf
 OP_CODES = _C = {name: i for i, name in enumerate(OPS)}
 NEG, SQR, SQRT, EXP, LOG, SIN, COS, TAN = (_C[k] for k in
                                            ("neg", "sqr", "sqrt", "exp", "log", "sin", "cos",
@@ -113,45 +115,100 @@ def _revise_piecewise(code, zl, zh, xl, xh, yl, yh):
 
 
 @nb.njit(cache=True, error_model="numpy")
-def _revise_pown(zl, zh, xl, xh, p, buf):
-    """HC4-revise of a ``pown`` node (integer exponent ``p``)."""
-    o0, o1 = buf[0:1], buf[1:2]
-    _f_pown(xl, xh, np.int64(p), o0, o1)
-    zl, zh = _cap(zl, zh, buf[0], buf[1])
-    _b_pown(zl, zh, xl, xh, np.int64(p), o0, o1)
-    return zl, zh, buf[0], buf[1]
+def _image_explog(code, xl, xh, yl, yh, buf):
+    """Forward image of an exponential-family node (exp, log, sinh, cosh, tanh, atan, atan2,
+    and the real power ``pow(x, y) = exp(y log x)``)."""
+    if code == POW:
+        _f_pow(xl, xh, yl, yh, buf[0:1], buf[1:2])
+        return buf[0], buf[1]
+    if code == ATAN2:
+        _f_atan2(xl, xh, yl, yh, buf[0:1], buf[1:2])
+        return buf[0], buf[1]
+    if code == EXP:
+        return _f_exp(xl, xh, math.exp(xl), math.exp(xh))
+    if code == LOG:
+        return _f_log(xl, xh, math.log(xl), math.log(xh))
+    if code == SINH:
+        return _f_sinh(xl, xh, math.sinh(xl), math.sinh(xh))
+    if code == COSH:
+        return _f_cosh(xl, xh, math.cosh(xl), math.cosh(xh))
+    if code == TANH:
+        return _f_tanh(xl, xh, math.tanh(xl), math.tanh(xh))
+    if code == ATAN:
+        return _f_atan(xl, xh, math.atan(xl), math.atan(xh))
+    return -INF, INF
 
 
 @nb.njit(cache=True, error_model="numpy")
-def _revise_explog(code, zl, zh, xl, xh, yl, yh, buf):
-    """HC4-revise of the exponential family (exp, log, sinh, cosh, tanh, atan, atan2, and the
-    real power ``pow(x, y) = exp(y log x)``)."""
+def _image_trig(code, xl, xh, buf):
+    """Forward image of a trigonometric node (sin, cos, tan, asin, acos)."""
+    if code == SIN:
+        _f_sin(xl, xh, buf[0:1], buf[1:2])
+        return buf[0], buf[1]
+    if code == COS:
+        _f_cos(xl, xh, buf[0:1], buf[1:2])
+        return buf[0], buf[1]
+    if code == TAN:
+        return _f_tan(xl, xh, math.tan(xl), math.tan(xh))
+    if code == ASIN:
+        return _f_asin(xl, xh, math.asin(xl), math.asin(xh))
+    if code == ACOS:  # asin is only used where |x| <= 1/2
+        return _f_acos(xl, xh, math.acos(xl), math.acos(xh),
+                       math.asin(xl) if abs(xl) <= 0.5 else 0.0,
+                       math.asin(xh) if abs(xh) <= 0.5 else 0.0)
+    return -INF, INF
+
+
+@nb.njit(cache=True, error_model="numpy")
+def image(code, xl, xh, yl, yh, p, buf, piecewise, pown, explog, trig):
+    """Forward image ``f(x, y)`` of node ``z = f(x, y)`` rounded outward, as ``(lo, hi)``
+    (NaN bounds: empty; the entire line for a node of a family left out, see :func:`revise`)."""
+    if code == ADD:
+        return _add_lo(xl, xh, yl, yh), _add_hi(xl, xh, yl, yh)
+    if code == MUL:
+        return _mul_lo(xl, xh, yl, yh), _mul_hi(xl, xh, yl, yh)
+    if code == SUB:
+        return _sub_lo(xl, xh, yl, yh), _sub_hi(xl, xh, yl, yh)
+    if code == DIV:
+        return _div_lo(xl, xh, yl, yh), _div_hi(xl, xh, yl, yh)
+    if code == SQR:
+        return _sqr_lo(xl, xh), _sqr_hi(xl, xh)
+    if code == SQRT:
+        return _sqrt_lo(xl, xh), _sqrt_hi(xl, xh)
+    if code == NEG:
+        return -xh, -xl
+    if pown is not None and code == POWN:
+        _f_pown(xl, xh, np.int64(p), buf[0:1], buf[1:2])
+        return buf[0], buf[1]
+    if piecewise is not None and code in (ABS, SIGN, FLOOR, CEIL, MIN, MAX):
+        if code == MIN:
+            return al._min_all(xl, xh, yl, yh)
+        if code == MAX:
+            return al._max_all(xl, xh, yl, yh)
+        if code == ABS:
+            return al._abs_all(xl, xh)
+        if code == SIGN:
+            return al._sign_all(xl, xh)
+        if code == FLOOR:
+            return al._floor_all(xl, xh)
+        return al._ceil_all(xl, xh)
+    if explog is not None and code in (EXP, LOG, SINH, COSH, TANH, ATAN, ATAN2, POW):
+        return _image_explog(code, xl, xh, yl, yh, buf)
+    if trig is not None and code in (SIN, COS, TAN, ASIN, ACOS):
+        return _image_trig(code, xl, xh, buf)
+    return -INF, INF
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _back_explog(code, zl, zh, xl, xh, yl, yh, buf):
+    """The reverse step of an exponential-family node (the forward image already in ``z``)."""
     o0, o1, o2, o3 = buf[0:1], buf[1:2], buf[2:3], buf[3:4]
     if code == POW:
-        _f_pow(xl, xh, yl, yh, o0, o1)
-        zl, zh = _cap(zl, zh, buf[0], buf[1])
         _b_pow(zl, zh, xl, xh, yl, yh, o0, o1, o2, o3)
-        return zl, zh, buf[0], buf[1], buf[2], buf[3]
+        return buf[0], buf[1], buf[2], buf[3]
     if code == ATAN2:
-        _f_atan2(xl, xh, yl, yh, o0, o1)
-        zl, zh = _cap(zl, zh, buf[0], buf[1])
         _b_atan2(zl, zh, xl, xh, yl, yh, o0, o1, o2, o3)
-        return zl, zh, buf[0], buf[1], buf[2], buf[3]
-    if code == EXP:
-        nl, nh = _f_exp(xl, xh, math.exp(xl), math.exp(xh))
-    elif code == LOG:
-        nl, nh = _f_log(xl, xh, math.log(xl), math.log(xh))
-    elif code == SINH:
-        nl, nh = _f_sinh(xl, xh, math.sinh(xl), math.sinh(xh))
-    elif code == COSH:
-        nl, nh = _f_cosh(xl, xh, math.cosh(xl), math.cosh(xh))
-    elif code == TANH:
-        nl, nh = _f_tanh(xl, xh, math.tanh(xl), math.tanh(xh))
-    elif code == ATAN:
-        nl, nh = _f_atan(xl, xh, math.atan(xl), math.atan(xh))
-    else:
-        return zl, zh, xl, xh, yl, yh
-    zl, zh = _cap(zl, zh, nl, nh)
+        return buf[0], buf[1], buf[2], buf[3]
     if code == EXP:
         _b_exp(zl, zh, xl, xh, o0, o1)
     elif code == LOG:
@@ -164,28 +221,13 @@ def _revise_explog(code, zl, zh, xl, xh, yl, yh, buf):
         _b_tanh(zl, zh, xl, xh, o0, o1)
     else:  # ATAN
         _b_atan(zl, zh, xl, xh, o0, o1)
-    return zl, zh, buf[0], buf[1], yl, yh
+    return buf[0], buf[1], yl, yh
 
 
 @nb.njit(cache=True, error_model="numpy")
-def _revise_trig(code, zl, zh, xl, xh, yl, yh, buf):
-    """HC4-revise of the trigonometric family (sin, cos, tan, asin, acos)."""
+def _back_trig(code, zl, zh, xl, xh, buf):
+    """The reverse step of a trigonometric node."""
     o0, o1 = buf[0:1], buf[1:2]
-    if code == SIN:
-        _f_sin(xl, xh, o0, o1)
-    elif code == COS:
-        _f_cos(xl, xh, o0, o1)
-    elif code == TAN:
-        buf[0], buf[1] = _f_tan(xl, xh, math.tan(xl), math.tan(xh))
-    elif code == ASIN:
-        buf[0], buf[1] = _f_asin(xl, xh, math.asin(xl), math.asin(xh))
-    elif code == ACOS:  # asin is only used where |x| <= 1/2
-        buf[0], buf[1] = _f_acos(xl, xh, math.acos(xl), math.acos(xh),
-                                 math.asin(xl) if abs(xl) <= 0.5 else 0.0,
-                                 math.asin(xh) if abs(xh) <= 0.5 else 0.0)
-    else:
-        return zl, zh, xl, xh, yl, yh
-    zl, zh = _cap(zl, zh, buf[0], buf[1])
     if code == SIN:
         _b_sin(zl, zh, xl, xh, o0, o1)
     elif code == COS:
@@ -196,49 +238,71 @@ def _revise_trig(code, zl, zh, xl, xh, yl, yh, buf):
         _b_asin(zl, zh, xl, xh, o0, o1)
     else:  # ACOS
         _b_acos(zl, zh, xl, xh, o0, o1)
-    return zl, zh, buf[0], buf[1], yl, yh
+    return buf[0], buf[1]
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _back_piecewise(code, zl, zh, xl, xh, yl, yh):
+    """The reverse step of a piecewise node (abs, sign, floor, ceil, min, max)."""
+    if code == MIN:
+        return al._min_rev_all(zl, zh, xl, xh, yl, yh)
+    if code == MAX:
+        return al._max_rev_all(zl, zh, xl, xh, yl, yh)
+    if code == ABS:
+        xl, xh = al._abs_rev_all(zl, zh, xl, xh)
+    elif code == SIGN:
+        xl, xh = al._sign_rev_all(zl, zh, xl, xh)
+    elif code == FLOOR:
+        xl, xh = al._floor_rev_all(zl, zh, xl, xh)
+    else:  # CEIL
+        xl, xh = al._ceil_rev_all(zl, zh, xl, xh)
+    return xl, xh, yl, yh
+
+
+@nb.njit(cache=True, error_model="numpy")
+def back(code, zl, zh, xl, xh, yl, yh, p, buf, piecewise, pown, explog, trig):
+    """The reverse step of node ``z = f(x, y)``: ``(x, y) ∩= f_rev(z, x, y)``, for a ``z``
+    already within the forward image. Returns ``(xl, xh, yl, yh)`` (NaN bounds: empty); a node
+    of a family left out (see :func:`revise`) contracts nothing."""
+    if code == ADD:
+        return al._add_rev_all(zl, zh, xl, xh, yl, yh)
+    if code == MUL:
+        return al._mul_rev_all(zl, zh, xl, xh, yl, yh)
+    if code == SUB:
+        return al._sub_rev_all(zl, zh, xl, xh, yl, yh)
+    if code == DIV:
+        return al._div_rev_all(zl, zh, xl, xh, yl, yh)
+    if code == SQR:
+        xl, xh = al._sqr_rev_all(zl, zh, xl, xh)
+    elif code == SQRT:
+        xl, xh = al._sqrt_rev_all(zl, zh, xl, xh)
+    elif code == NEG:
+        xl, xh = al._neg_rev_all(zl, zh, xl, xh)
+    elif pown is not None and code == POWN:
+        _b_pown(zl, zh, xl, xh, np.int64(p), buf[0:1], buf[1:2])
+        xl, xh = buf[0], buf[1]
+    elif piecewise is not None and code in (ABS, SIGN, FLOOR, CEIL, MIN, MAX):
+        return _back_piecewise(code, zl, zh, xl, xh, yl, yh)
+    elif explog is not None and code in (EXP, LOG, SINH, COSH, TANH, ATAN, ATAN2, POW):
+        return _back_explog(code, zl, zh, xl, xh, yl, yh, buf)
+    elif trig is not None and code in (SIN, COS, TAN, ASIN, ACOS):
+        xl, xh = _back_trig(code, zl, zh, xl, xh, buf)
+    return xl, xh, yl, yh
 
 
 @nb.njit(cache=True, error_model="numpy")
 def revise(code, zl, zh, xl, xh, yl, yh, p, buf, piecewise, pown, explog, trig):
-    """HC4-revise of node ``z = f(x, y)``: ``z ∩= f(x, y)``, then ``(x, y) = f_rev(z, x, y)``.
+    """HC4-revise of node ``z = f(x, y)``: ``z ∩= f(x, y)`` (:func:`image`), then
+    ``(x, y) = f_rev(z, x, y)`` (:func:`back`).
 
     Returns the new ``(zl, zh, xl, xh, yl, yh)``. The basic arithmetic is inline; each other
     family is one kernel, compiled in only when its argument (``piecewise``, ``pown``,
     ``explog``, ``trig``) is not ``None`` (Numba prunes ``x is not None`` on a ``None``
     argument before typing). A node of a family left out is not contracted, which is sound.
     """
-    if code == ADD:
-        zl, zh = _cap(zl, zh, _add_lo(xl, xh, yl, yh), _add_hi(xl, xh, yl, yh))
-        xl, xh, yl, yh = al._add_rev_all(zl, zh, xl, xh, yl, yh)
-    elif code == MUL:
-        zl, zh = _cap(zl, zh, _mul_lo(xl, xh, yl, yh), _mul_hi(xl, xh, yl, yh))
-        xl, xh, yl, yh = al._mul_rev_all(zl, zh, xl, xh, yl, yh)
-    elif code == SUB:
-        zl, zh = _cap(zl, zh, _sub_lo(xl, xh, yl, yh), _sub_hi(xl, xh, yl, yh))
-        xl, xh, yl, yh = al._sub_rev_all(zl, zh, xl, xh, yl, yh)
-    elif code == DIV:
-        zl, zh = _cap(zl, zh, _div_lo(xl, xh, yl, yh), _div_hi(xl, xh, yl, yh))
-        xl, xh, yl, yh = al._div_rev_all(zl, zh, xl, xh, yl, yh)
-    elif code == SQR:
-        zl, zh = _cap(zl, zh, _sqr_lo(xl, xh), _sqr_hi(xl, xh))
-        xl, xh = al._sqr_rev_all(zl, zh, xl, xh)
-    elif code == SQRT:
-        zl, zh = _cap(zl, zh, _sqrt_lo(xl, xh), _sqrt_hi(xl, xh))
-        xl, xh = al._sqrt_rev_all(zl, zh, xl, xh)
-    elif code == NEG:
-        zl, zh = _cap(zl, zh, -xh, -xl)
-        xl, xh = al._neg_rev_all(zl, zh, xl, xh)
-    else:
-        if pown is not None and code == POWN:
-            zl, zh, xl, xh = _revise_pown(zl, zh, xl, xh, p, buf)
-            return zl, zh, xl, xh, yl, yh
-        if piecewise is not None and code in (ABS, SIGN, FLOOR, CEIL, MIN, MAX):
-            return _revise_piecewise(code, zl, zh, xl, xh, yl, yh)
-        if explog is not None and code in (EXP, LOG, SINH, COSH, TANH, ATAN, ATAN2, POW):
-            return _revise_explog(code, zl, zh, xl, xh, yl, yh, buf)
-        if trig is not None:
-            return _revise_trig(code, zl, zh, xl, xh, yl, yh, buf)
+    nl, nh = image(code, xl, xh, yl, yh, p, buf, piecewise, pown, explog, trig)
+    zl, zh = _cap(zl, zh, nl, nh)
+    xl, xh, yl, yh = back(code, zl, zh, xl, xh, yl, yh, p, buf, piecewise, pown, explog, trig)
     return zl, zh, xl, xh, yl, yh
 
 
