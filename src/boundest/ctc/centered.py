@@ -47,7 +47,7 @@ from .linear_forms import (
     point_times,
     square_preconditioner,
 )
-from .revise import family_flags, revise_nodes
+from .revise import _meet, back, family_flags
 from .windows import WINDOW_STATS, batch_kernel
 
 __all__ = ["CtcCentered", "CtcNewton"]
@@ -173,13 +173,31 @@ def _centered_step(jl, jh, zl, zh, dl, dh, precondition, ws_m, ws_mn, ws_mm, piv
 
 
 @_njit
+def _backward(op, out, a, b, param, lo, hi, buf, piecewise, pown, explog, trig):
+    """The backward sweep of HC4 on slots that hold the forward images (the nodes last to
+    first, each node's arguments contracted by :func:`~boundest.ctc.revise.back` from its
+    slot, which is not re-evaluated: Codac 2's ``bwd``); False as soon as a slot is empty."""
+    for i in range(op.size - 1, -1, -1):
+        o, ia, ib = out[i], a[i], b[i]
+        yl, yh = (lo[ib], hi[ib]) if ib >= 0 else (0.0, 0.0)
+        xl, xh, yl, yh = back(op[i], lo[o], hi[o], lo[ia], hi[ia], yl, yh, param[i], buf,
+                              piecewise, pown, explog, trig)
+        if not _meet(lo, hi, ia, xl, xh):
+            return False
+        if ib >= 0 and not _meet(lo, hi, ib, yl, yh):
+            return False
+    return True
+
+
+@_njit
 def _centered_kernel(op, out, a, b, param, node_ptr, out_slot, row_ptr, cols, slot_lo, slot_hi,
                      tl, th, xl, xh, precondition, hc4, piecewise, pown, explog, trig):
     """Contract each box ``(xl[b], xh[b])`` in place (an empty box gets NaN bounds): the
-    forward images over the box, its Jacobian (reverse mode), the outputs at its centre, the
-    centered step (:func:`_centered_step`) on ``(Y & f(X)) - f(c)`` and, with ``hc4``, one
-    forward-backward pass over the tape on the contracted box. The targets ``tl, th`` are per
-    box, shape (n_boxes, m). One call per batch; the workspaces are allocated once."""
+    forward images over the box, its Jacobian (forward mode), the outputs at its centre, the
+    centered step (:func:`_centered_step`) on ``(Y & f(X)) - f(c)`` and, with ``hc4``, the
+    backward sweep of HC4 (:func:`_backward`) from the forward images over the box as given and
+    the variables as the centered step left them. The targets ``tl, th`` are per box, shape
+    (n_boxes, m). One call per batch; the workspaces are allocated once."""
     n = xl.shape[1]
     m = out_slot.size
     ns = slot_lo.size
@@ -261,8 +279,8 @@ def _centered_kernel(op, out, a, b, param, node_ptr, out_slot, row_ptr, cols, sl
                 sl[o], sh[o] = max(sl[o], tl[bx, k]), min(sh[o], th[bx, k])
                 if not sl[o] <= sh[o]:
                     empty = True
-            if not empty and revise_nodes(op, out, a, b, param, sl, sh, buf, np.int64(1),
-                                          piecewise, pown, explog, trig):
+            if not empty and _backward(op, out, a, b, param, sl, sh, buf, piecewise, pown,
+                                       explog, trig):
                 for j in range(n):
                     xl[bx, j] = max(xl[bx, j], sl[j])
                     xh[bx, j] = min(xh[bx, j], sh[j])
@@ -312,10 +330,10 @@ class CtcCentered(_Linearised):
         (:mod:`boundest.ctc.windows`: the hull of the linearised set up to the Jacobian's
         width, two small dense simplexes per variable and box).
     hc4 : bool
-        Then one backward sweep of forward-backward propagation (HC4-revise, node by node in
-        reverse) from the forward images over the box as given, on the variables as the
-        centered step left them: Codac 2's ``CtcInverse(f, y)``, in the same kernel (not
-        with ``"lp"``).
+        Then one backward sweep of forward-backward propagation (the reverse step of each
+        node, last to first) from the forward images over the box as given, on the variables
+        as the centered step left them: Codac 2's ``CtcInverse(f, y)``, in the same kernel
+        (not with ``"lp"``).
 
     Examples
     --------
