@@ -219,27 +219,55 @@ class Op(Expr):
         self.name, self.args, self.param = name, args, param
 
     def __str__(self) -> str:
-        if self.name in _INFIX:
-            sym, prec = _INFIX[self.name]
-            a, b = (_paren(arg, prec, right=i == 1) for i, arg in enumerate(self.args))
-            return f"{a} {sym} {b}"
-        if self.name == "neg":
-            return f"-{_paren(self.args[0], 3)}"
-        if self.name == "sqr":
-            return f"{_paren(self.args[0], 4)}^2"
-        if self.name == "pown":
-            return f"{_paren(self.args[0], 4)}^{self.param}"
-        return f"{self.name}({', '.join(str(a) for a in self.args)})"
+        return _render(self)
 
 
-def _paren(e: Expr, prec: int, right: bool = False) -> str:
+def _prec(e: Expr) -> int | None:
+    """The precedence ``e`` is printed at, or None for an atom that never needs parentheses
+    (a non-negative constant, a variable)."""
     if isinstance(e, Op):
-        p = _INFIX.get(e.name, (None, 5 if e.name not in ("neg",) else 3))[1]
-        if p < prec or (right and p == prec):
-            return f"({e})"
-    elif isinstance(e, Const) and float(e.value.lo) < 0:
-        return f"({e})"
-    return str(e)
+        return _INFIX[e.name][1] if e.name in _INFIX else 3 if e.name == "neg" else 5
+    if isinstance(e, Const) and float(e.value.lo) < 0:
+        return -1  # printed with a sign: parenthesised wherever an operand
+    return None
+
+
+def _operand(e: Expr, prec: int, right: bool = False) -> list:
+    """``e`` as the operand of an operator of precedence ``prec``, parenthesised if needed."""
+    p = _prec(e)
+    if p is not None and (p < prec or (right and p == prec)):
+        return ["(", e, ")"]
+    return [e]
+
+
+def _render(root: Expr) -> str:
+    """The text of ``root``: an explicit stack of pieces (text or a sub-expression still to
+    print), so that an expression of any depth prints in time linear in its text."""
+    out: list[str] = []
+    stack: list[str | Expr] = [root]
+    while stack:
+        item = stack.pop()
+        if isinstance(item, str):
+            out.append(item)
+            continue
+        if not isinstance(item, Op):
+            out.append(str(item))
+            continue
+        name, args = item.name, item.args
+        if name in _INFIX:
+            sym, prec = _INFIX[name]
+            parts = [*_operand(args[0], prec), f" {sym} ", *_operand(args[1], prec, right=True)]
+        elif name == "neg":
+            parts = ["-", *_operand(args[0], 3)]
+        elif name in ("sqr", "pown"):
+            parts = [*_operand(args[0], 4), "^2" if name == "sqr" else f"^{item.param}"]
+        else:
+            parts = [f"{name}("]
+            for i, a in enumerate(args):
+                parts += [", ", a] if i else [a]
+            parts.append(")")
+        stack.extend(reversed(parts))
+    return "".join(out)
 
 
 class Constraint:
