@@ -221,6 +221,10 @@ class Op(Expr):
     def __str__(self) -> str:
         return _render(self)
 
+    def __reduce__(self) -> tuple:
+        # pickle and copy would recurse once per level of the tree: a flat table instead
+        return _decode_one, (_encode([self]),)
+
 
 def _prec(e: Expr) -> int | None:
     """The precedence ``e`` is printed at, or None for an atom that never needs parentheses
@@ -270,6 +274,54 @@ def _render(root: Expr) -> str:
     return "".join(out)
 
 
+def _encode(roots: Iterable[Expr]) -> tuple[list, list[int]]:
+    """Expressions as a flat table in post-order, and the index of each root in it.
+
+    An entry is a leaf (a ``Var`` or ``Const``, pickled as itself) or ``(name, param, i, ...)``
+    for an ``Op`` over the entries ``i, ...``. A sub-expression reused by identity is one entry,
+    so the table is as large as the DAG, and decoding restores the sharing.
+    """
+    index: dict[int, int] = {}
+    table: list = []
+    positions: list[int] = []
+    for root in roots:
+        stack: list[tuple[Expr, bool]] = [(root, False)]
+        while stack:
+            e, expanded = stack.pop()
+            if id(e) in index:
+                continue
+            if isinstance(e, Op) and not expanded:
+                stack.append((e, True))
+                stack.extend((a, False) for a in reversed(e.args) if id(a) not in index)
+                continue
+            index[id(e)] = len(table)
+            table.append((e.name, e.param, *(index[id(a)] for a in e.args))
+                         if isinstance(e, Op) else e)
+        positions.append(index[id(root)])
+    return table, positions
+
+
+def _decode(table: list, positions: list[int]) -> list[Expr]:
+    """The roots of an ``_encode`` table, rebuilt."""
+    built: list[Expr] = []
+    for entry in table:
+        if isinstance(entry, tuple):
+            name, param, *idx = entry
+            built.append(Op(name, tuple(built[i] for i in idx), param))
+        else:
+            built.append(entry)
+    return [built[i] for i in positions]
+
+
+def _decode_one(enc: tuple[list, list[int]]) -> Expr:
+    return _decode(*enc)[0]
+
+
+def _decode_constraint(rel: str, enc: tuple[list, list[int]]) -> Constraint:
+    lhs, rhs = _decode(*enc)
+    return Constraint(lhs, rel, rhs)
+
+
 class Constraint:
     """``lhs rel rhs`` with ``rel`` one of ``==``, ``<=``, ``>=``, ``in`` (rhs a constant)."""
 
@@ -285,6 +337,9 @@ class Constraint:
 
     def __repr__(self) -> str:
         return f"Constraint({self})"
+
+    def __reduce__(self) -> tuple:
+        return _decode_constraint, (self.rel, _encode([self.lhs, self.rhs]))
 
     def __bool__(self) -> bool:
         raise TypeError("a constraint has no truth value; add it to a model instead")
