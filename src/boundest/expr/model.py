@@ -6,7 +6,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass, field
 
 from ..interval import Interval
-from .nodes import Constraint, Var, variables
+from .nodes import Constraint, Var, _decode, _encode, variables
 
 __all__ = ["Model"]
 
@@ -54,6 +54,24 @@ class Model:
         known = set(names)
         names += [v.name for v in variables(self.constraints) if v.name not in known]
         return names
+
+    def __getstate__(self) -> dict:
+        # the expressions of all constraints as one flat table: pickling (a model sent to a
+        # worker process) and deepcopy would otherwise recurse once per level of an expression,
+        # and a sub-expression shared by two constraints stays one object
+        state = dict(self.__dict__)
+        cons = state.pop("constraints")
+        table, roots = _encode(e for c in cons for e in (c.lhs, c.rhs))
+        state["_constraints"] = ([c.rel for c in cons], table, roots)
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        state = dict(state)
+        rels, table, roots = state.pop("_constraints")
+        exprs = _decode(table, roots)
+        state["constraints"] = [Constraint(exprs[2 * i], rel, exprs[2 * i + 1])
+                                for i, rel in enumerate(rels)]
+        self.__dict__.update(state)
 
     def __repr__(self) -> str:
         return (f"Model({len(self.variable_names())} variables, "

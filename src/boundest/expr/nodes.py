@@ -219,27 +219,107 @@ class Op(Expr):
         self.name, self.args, self.param = name, args, param
 
     def __str__(self) -> str:
-        if self.name in _INFIX:
-            sym, prec = _INFIX[self.name]
-            a, b = (_paren(arg, prec, right=i == 1) for i, arg in enumerate(self.args))
-            return f"{a} {sym} {b}"
-        if self.name == "neg":
-            return f"-{_paren(self.args[0], 3)}"
-        if self.name == "sqr":
-            return f"{_paren(self.args[0], 4)}^2"
-        if self.name == "pown":
-            return f"{_paren(self.args[0], 4)}^{self.param}"
-        return f"{self.name}({', '.join(str(a) for a in self.args)})"
+        return _render(self)
+
+    def __reduce__(self) -> tuple:
+        # pickle and copy would recurse once per level of the tree: a flat table instead
+        return _decode_one, (_encode([self]),)
 
 
-def _paren(e: Expr, prec: int, right: bool = False) -> str:
+def _prec(e: Expr) -> int | None:
+    """The precedence ``e`` is printed at, or None for an atom that never needs parentheses
+    (a non-negative constant, a variable)."""
     if isinstance(e, Op):
-        p = _INFIX.get(e.name, (None, 5 if e.name not in ("neg",) else 3))[1]
-        if p < prec or (right and p == prec):
-            return f"({e})"
-    elif isinstance(e, Const) and float(e.value.lo) < 0:
-        return f"({e})"
-    return str(e)
+        return _INFIX[e.name][1] if e.name in _INFIX else 3 if e.name == "neg" else 5
+    if isinstance(e, Const) and float(e.value.lo) < 0:
+        return -1  # printed with a sign: parenthesised wherever an operand
+    return None
+
+
+def _operand(e: Expr, prec: int, right: bool = False) -> list:
+    """``e`` as the operand of an operator of precedence ``prec``, parenthesised if needed."""
+    p = _prec(e)
+    if p is not None and (p < prec or (right and p == prec)):
+        return ["(", e, ")"]
+    return [e]
+
+
+def _render(root: Expr) -> str:
+    """The text of ``root``: an explicit stack of pieces (text or a sub-expression still to
+    print), so that an expression of any depth prints in time linear in its text."""
+    out: list[str] = []
+    stack: list[str | Expr] = [root]
+    while stack:
+        item = stack.pop()
+        if isinstance(item, str):
+            out.append(item)
+            continue
+        if not isinstance(item, Op):
+            out.append(str(item))
+            continue
+        name, args = item.name, item.args
+        if name in _INFIX:
+            sym, prec = _INFIX[name]
+            parts = [*_operand(args[0], prec), f" {sym} ", *_operand(args[1], prec, right=True)]
+        elif name == "neg":
+            parts = ["-", *_operand(args[0], 3)]
+        elif name in ("sqr", "pown"):
+            parts = [*_operand(args[0], 4), "^2" if name == "sqr" else f"^{item.param}"]
+        else:
+            parts = [f"{name}("]
+            for i, a in enumerate(args):
+                parts += [", ", a] if i else [a]
+            parts.append(")")
+        stack.extend(reversed(parts))
+    return "".join(out)
+
+
+def _encode(roots: Iterable[Expr]) -> tuple[list, list[int]]:
+    """Expressions as a flat table in post-order, and the index of each root in it.
+
+    An entry is a leaf (a ``Var`` or ``Const``, pickled as itself) or ``(name, param, i, ...)``
+    for an ``Op`` over the entries ``i, ...``. A sub-expression reused by identity is one entry,
+    so the table is as large as the DAG, and decoding restores the sharing.
+    """
+    index: dict[int, int] = {}
+    table: list = []
+    positions: list[int] = []
+    for root in roots:
+        stack: list[tuple[Expr, bool]] = [(root, False)]
+        while stack:
+            e, expanded = stack.pop()
+            if id(e) in index:
+                continue
+            if isinstance(e, Op) and not expanded:
+                stack.append((e, True))
+                stack.extend((a, False) for a in reversed(e.args) if id(a) not in index)
+                continue
+            index[id(e)] = len(table)
+            table.append((e.name, e.param, *(index[id(a)] for a in e.args))
+                         if isinstance(e, Op) else e)
+        positions.append(index[id(root)])
+    return table, positions
+
+
+def _decode(table: list, positions: list[int]) -> list[Expr]:
+    """The roots of an ``_encode`` table, rebuilt."""
+    built: list[Expr] = []
+    for entry in table:
+        if isinstance(entry, tuple):
+            name, param, *idx = entry
+            built.append(Op(name, tuple(built[i] for i in idx), param))
+        else:
+            built.append(entry)
+    return [built[i] for i in positions]
+
+
+def _decode_one(enc: tuple[list, list[int]]) -> Expr:
+    return _decode(*enc)[0]
+
+
+def _decode_constraint(rel: str, enc: tuple[list, list[int]]) -> Constraint:
+    lhs, rhs = _decode(*enc)
+    return Constraint(lhs, rel, rhs)
 
 
 class Constraint:
@@ -257,6 +337,9 @@ class Constraint:
 
     def __repr__(self) -> str:
         return f"Constraint({self})"
+
+    def __reduce__(self) -> tuple:
+        return _decode_constraint, (self.rel, _encode([self.lhs, self.rhs]))
 
     def __bool__(self) -> bool:
         raise TypeError("a constraint has no truth value; add it to a model instead")

@@ -31,7 +31,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from lark import Lark, Token, Transformer, v_args
+from lark import Lark, Token, Transformer_NonRecursive, v_args
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, VisitError
 
 from .._textfile import read_text
@@ -53,11 +53,11 @@ domain: LB bound "," bound RB
            | expr ">=" expr  -> ge
            | expr _IN domain -> within
 ?expr: term
-     | expr "+" term -> add
-     | expr "-" term -> sub
+     | term (_addop term)+ -> sum
 ?term: factor
-     | term "*" factor -> mul
-     | term "/" factor -> div
+     | factor (_mulop factor)+ -> product
+!_addop: "+" | "-"
+!_mulop: "*" | "/"
 ?factor: power
        | "-" factor -> neg
 ?power: atom
@@ -99,7 +99,21 @@ def decimal_value(text: str) -> tuple[Interval, tuple[int, str, int]]:
     return Interval(lo, hi), exact
 
 
-class _Build(Transformer):
+_BINOP = {"+": "add", "-": "sub", "*": "mul", "/": "div"}
+
+
+def _fold(items: list) -> Op:
+    """``a op b op c ...`` (operands and operator tokens alternating) as the left-deep binary
+    tree of the Python front end, ``((a op b) op c) ...``, built by a loop."""
+    e = items[0]
+    for i in range(1, len(items), 2):
+        e = Op(_BINOP[str(items[i])], (e, items[i + 1]))
+    return e
+
+
+class _Build(Transformer_NonRecursive):
+    """The model of a parse tree, built bottom-up without recursion (a tree of any depth)."""
+
     def __init__(self, source: str) -> None:
         super().__init__()
         self.source = source
@@ -178,21 +192,11 @@ class _Build(Transformer):
         except ValueError as exc:
             raise self._err(tok, str(exc)) from None
 
-    @v_args(inline=True)
-    def add(self, a, b):
-        return a + b
+    def sum(self, items):
+        return _fold(items)
 
-    @v_args(inline=True)
-    def sub(self, a, b):
-        return a - b
-
-    @v_args(inline=True)
-    def mul(self, a, b):
-        return a * b
-
-    @v_args(inline=True)
-    def div(self, a, b):
-        return a / b
+    def product(self, items):
+        return _fold(items)
 
     @v_args(inline=True)
     def neg(self, a):

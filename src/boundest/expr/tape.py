@@ -114,46 +114,63 @@ class _Builder:
         """The slot of ``e`` (a fresh one where ``e`` holds a non-degenerate constant)."""
         return self._expr(e)[0]
 
-    def _expr(self, e: Expr) -> tuple[int, bool]:
-        """``(slot, shared)``; ``shared`` is False when ``e`` contains an occurrence of a
-        non-degenerate constant, whose slot must not serve another occurrence of ``e``."""
-        s = self.memo.get(id(e))
-        if s is not None:
-            return s, True
-        shared = True
-        if isinstance(e, Var):
-            s = self.var(e.name)
-        elif isinstance(e, Const):
-            lo, hi = float(e.value.lo), float(e.value.hi)
-            key: tuple | None = ("point", lo) if lo == hi else (
-                None if e.exact is None else ("exact", e.exact))
-            if key is None:
-                s, shared = self.new_slot(lo, hi), False
+    def _expr(self, root: Expr) -> tuple[int, bool]:
+        """``(slot, shared)``; ``shared`` is False when ``root`` contains an occurrence of a
+        non-degenerate constant, whose slot must not serve another occurrence of ``root``.
+
+        A post-order walk with an explicit stack (a tree of any depth): the arguments of an
+        operation in order, then the operation, as a recursion would visit them.
+        """
+        done: list[tuple[int, bool]] = []  # the results of the walk, arguments before ops
+        stack: list[tuple[Expr, bool]] = [(root, False)]
+        while stack:
+            e, expanded = stack.pop()
+            if not expanded:
+                s = self.memo.get(id(e))
+                if s is not None:
+                    done.append((s, True))
+                    continue
+                if isinstance(e, Op):
+                    stack.append((e, True))
+                    stack.extend((x, False) for x in reversed(e.args))
+                    continue
+            shared = True
+            if isinstance(e, Var):
+                s = self.var(e.name)
+            elif isinstance(e, Const):
+                lo, hi = float(e.value.lo), float(e.value.hi)
+                key: tuple | None = ("point", lo) if lo == hi else (
+                    None if e.exact is None else ("exact", e.exact))
+                if key is None:
+                    s, shared = self.new_slot(lo, hi), False
+                else:
+                    s = self.const_slot.get(key)
+                    if s is None:
+                        s = self.const_slot[key] = self.new_slot(lo, hi)
+                    else:  # the same number: both enclosures contain it
+                        self.restrict(s, lo, hi)
+            elif isinstance(e, Op):
+                k = len(e.args)
+                args = done[-k:]
+                del done[-k:]
+                shared = all(sh for _, sh in args)
+                a, b = args[0][0], (args[1][0] if k == 2 else -1)
+                param = float(e.param) if e.param is not None else 0.0
+                key = (_CODE[e.name], a, b, param)
+                node = self.node_of.get(key)  # a fresh argument slot makes the key unique
+                if node is None:
+                    s = self.new_slot()
+                    self.node_of[key] = len(self.nodes)
+                    self.nodes.append((key[0], s, a, b, param))
+                else:
+                    s = self.nodes[node][1]
             else:
-                s = self.const_slot.get(key)
-                if s is None:
-                    s = self.const_slot[key] = self.new_slot(lo, hi)
-                else:  # the same number: both enclosures contain it
-                    self.restrict(s, lo, hi)
-        elif isinstance(e, Op):
-            args = [self._expr(x) for x in e.args]
-            shared = all(sh for _, sh in args)
-            a, b = args[0][0], (args[1][0] if len(args) == 2 else -1)
-            param = float(e.param) if e.param is not None else 0.0
-            key = (_CODE[e.name], a, b, param)
-            node = self.node_of.get(key)  # a fresh argument slot makes the key unique
-            if node is None:
-                s = self.new_slot()
-                self.node_of[key] = len(self.nodes)
-                self.nodes.append((key[0], s, a, b, param))
-            else:
-                s = self.nodes[node][1]
-        else:
-            raise TypeError(f"not an expression: {e!r}")
-        if shared:
-            self.memo[id(e)] = s
-            self.keep.append(e)
-        return s, shared
+                raise TypeError(f"not an expression: {e!r}")
+            if shared:
+                self.memo[id(e)] = s
+                self.keep.append(e)
+            done.append((s, shared))
+        return done[0]
 
     def restrict(self, s: int, lo: float, hi: float) -> None:
         if lo != lo or hi != hi:  # an empty domain (NaN bounds): Python's max would drop it
