@@ -301,3 +301,46 @@ def test_out_creates_its_missing_folders(tmp_path, capsys):
     assert main(["run", "jaulin2001", "--boxes", "--out", str(out)]) == 0
     assert (out / "jaulin2001_rcse_ncse.png").exists() or any(out.glob("*.png"))
 
+
+def _inconsistent_satellite(tmp: Path) -> Path:
+    """The first 11 rows of the embedded data, y2 and y3 of k = 4 moved by 0.8: hull consistency
+    finds no contradiction, 3B shaving proves the CSP empty."""
+    from boundest.scenarios._data import embedded
+
+    rows = [r.split(",") for r in embedded("satellite_k200.csv").read_text().splitlines()[:12]]
+    for j in (5, 6):
+        rows[5][j] = repr(float(rows[5][j]) + 0.8)
+    f = tmp / "sat.csv"
+    f.write_text("".join(",".join(r) + "\n" for r in rows))
+    return f
+
+
+def test_beta_tuning_tunes_in_the_mode_asked_for(tmp_path, capsys):
+    """``--beta-tuning --mode 3b``: the beta found is one at which 3B shaving (not hull
+    consistency alone) leaves the CSP non-empty, and the enclosures are 3B's."""
+    import json
+
+    from boundest.csp import propagate
+    from boundest.scenarios import satellite as sat
+
+    f, js = _inconsistent_satellite(tmp_path), tmp_path / "s.json"
+    meas = sat.load(f)
+    assert sat.solve(meas, mode="hc4").consistent and not sat.solve(meas, mode="3b").consistent
+    assert main(["run", "satellite", "--data", str(f), "--mode", "3b", "--beta-tuning",
+                 "--out", str(tmp_path), "--json", str(js)]) == 0
+    out = capsys.readouterr().out
+    data = json.loads(js.read_text())
+    assert data["mode"] == "3b" and data["consistent"] and data["shaving"], data["mode"]
+    assert "mode 3b: hull consistency, then shaving" in out and "  mode hc4:" not in out
+    beta = data["beta"]
+    hc4_beta = sat.tune(meas, mode="hc4")[0].beta
+    assert beta > hc4_beta  # hull consistency's beta: 3B proves the CSP empty there
+
+    def in_3b(b: float) -> bool:
+        tape = sat.compile_model(sat.build_model(meas, beta=b))
+        names = [v for row in sat._state_names(meas.k_max) for v in row]
+        return propagate(tape, mode="3b", shave=names, shaving=sat.SHAVING, targets=names,
+                         rel_eps=1e-3).consistent
+
+    assert in_3b(beta) and not in_3b(hc4_beta) and not in_3b(beta * (1 - 2e-3))
+

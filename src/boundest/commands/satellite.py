@@ -32,9 +32,11 @@ def _run(args: argparse.Namespace, figures: FigureWorker) -> int:
     res = sat.solve(meas, rel_eps=args.rel_eps, mode=args.mode)
     if not res.consistent and args.beta_tuning:
         print("the CSP is empty: the data contradict the model; beta-tuning ...")
-        bres, res = sat.tune(meas, rel_eps=args.rel_eps)
-        print(f"smallest beta with a non-empty contraction: {bres.beta:.4f} "
-              f"({len(bres.trials)} propagations, {bres.time_s:.2f} s)")
+        bres, res = sat.tune(meas, rel_eps=args.rel_eps, mode=args.mode)
+        how = ("bisection by hull consistency" if args.mode == "hc4" else
+               f"bisection by hull consistency, then mode {args.mode} from its beta on")
+        print(f"smallest beta with a non-empty contraction in mode {args.mode}: "
+              f"{bres.beta:.4f} ({len(bres.trials)} propagations, {how}, {bres.time_s:.2f} s)")
     if not res.consistent:
         print("proven INCONSISTENT: no state trajectory satisfies the model and the data "
               "(rerun with --beta-tuning to relax the perturbation and output bounds)")
@@ -108,7 +110,9 @@ def register(runs: argparse._SubParsersAction) -> None:
                           "alone; hc4: hull consistency alone (fastest); "
                           "benchmarks/README.md compares them")
     sat.add_argument("--beta-tuning", action="store_true",
-                     help="if the CSP is empty, search the smallest relaxation beta")
+                     help="if the CSP is empty, search the smallest relaxation beta for which "
+                          "--mode does not prove it empty (a bisection by hull consistency, "
+                          "then in --mode from its result)")
     sat.add_argument("--out", default="out", help="folder for figures, created if missing "
                                                   "(default: out)")
     sat.add_argument("--json", help="write the enclosures as JSON to this file, in an existing "
