@@ -344,3 +344,34 @@ def test_beta_tuning_tunes_in_the_mode_asked_for(tmp_path, capsys):
 
     assert in_3b(beta) and not in_3b(hc4_beta) and not in_3b(beta * (1 - 2e-3))
 
+
+# -- item 6: every worker asked for gets a part ---------------------------------------------
+@pytest.mark.parametrize(("missions", "chunk", "workers", "size", "why"), [
+    (10, 250, 2, 5, "--mc-chunk 250 cut to 5 so that each of the 2 workers gets a part"),
+    (9, 250, 4, 2, "cut to 2"),
+    (1000, 250, 2, 250, ""),
+    (10, 250, 1, 10, ""),
+    (3, 250, 8, 1, "one mission per task: 3 mission(s) for 8 workers, so 3 worker process(es)"),
+])
+def test_tasks_for_gives_every_worker_a_part(missions, chunk, workers, size, why):
+    got, said = mc_cmd.tasks_for(missions, chunk, workers)
+    assert got == size and why in said and bool(said) == bool(why)
+    assert -(-missions // got) >= min(workers, missions)  # a task for every worker used
+
+
+def test_workers_with_fewer_missions_than_a_chunk_all_get_work(tmp_path, capsys, monkeypatch):
+    """``--workers 2 --monte-carlo 10`` with the default chunk of 250: two tasks of 5, said."""
+    from boundest.scenarios import pool_mc
+
+    seen = {}
+
+    def record(missions, q, m, *, chunk, executor, **kwargs):
+        seen.update(missions=missions, chunk=chunk, workers=executor._max_workers)
+        raise ValueError("recorded")
+
+    monkeypatch.setattr(pool_mc, "pool_monte_carlo", record)
+    assert main(["run", "pool", "--monte-carlo", "10", "--workers", "2", "--out",
+                 str(tmp_path)]) == 2
+    assert seen == {"missions": 10, "chunk": 5, "workers": 2}
+    assert "chunks of 5 missions (--mc-chunk 250 cut to 5 so that each of the 2 workers gets " \
+           "a part), on 2 local worker processes" in capsys.readouterr().out

@@ -49,7 +49,7 @@ def check(args: argparse.Namespace) -> None:
     chunk = min(args.mc_chunk, args.monte_carlo)
     per_task = WORKER_BYTES + observer_bytes(args.m, heading_slices(args)) \
         + chunk * BYTES_PER_MISSION
-    workers = args.workers or 1
+    workers = processes(args) or 1
     option = (f"--mc-chunk {args.mc_chunk}" if workers == 1 else
               f"--workers {args.workers} --mc-chunk {args.mc_chunk}")
     check_size(workers * per_task, f"{workers} process(es) at a time, each on a chunk of "
@@ -58,6 +58,29 @@ def check(args: argparse.Namespace) -> None:
     if workers > cores:
         announce(f"--workers {args.workers}: {workers} worker processes for the {cores} cores "
                  "of this machine: they take turns")
+
+
+def tasks_for(missions: int, chunk: int, workers: int, local: bool = True) -> tuple[int, str]:
+    """The missions per task, and why they differ from ``chunk`` (empty: they do not):
+    chunks of ``chunk`` missions, cut smaller when there would be fewer tasks than ``workers``,
+    so that every worker gets a part; with fewer missions than workers, one mission per task
+    (``local``: the local pool then starts one process per mission, see :func:`processes`)."""
+    tasks = -(-missions // chunk)
+    if workers <= 1 or tasks >= workers:
+        return min(chunk, missions), ""
+    if missions < workers:
+        idle = (f"so {missions} worker process(es), not {workers}" if local else
+                f"{workers - missions} of the cluster's {workers} worker threads idle")
+        return 1, f"one mission per task: {missions} mission(s) for {workers} workers, {idle}"
+    size = missions // workers  # at least `workers` tasks: 9 on 4 workers as 2+2+2+2+1, not 3+3+3
+    return size, (f"--mc-chunk {chunk} cut to {size} so that each of the {workers} workers "
+                  "gets a part")
+
+
+def processes(args: argparse.Namespace) -> int | None:
+    """The local worker processes to start: ``--workers``, but no more than the missions (a
+    process without a task would only cost its start); None without ``--workers``."""
+    return None if args.workers is None else min(args.workers, args.monte_carlo)
 
 
 @contextlib.contextmanager
@@ -75,7 +98,7 @@ def executor_of(args: argparse.Namespace) -> Iterator[Executor | None]:
         finally:
             ex._client.close()
     elif args.workers:
-        with ProcessPoolExecutor(args.workers) as ex:
+        with ProcessPoolExecutor(processes(args)) as ex:
             yield ex
     else:
         yield None
@@ -108,16 +131,21 @@ def run_monte_carlo(args: argparse.Namespace) -> int:
     Returns 0 when the frequency is at or above the claimed bound at every step, else 1."""
     import numpy as np
 
+    from ..parallel import executor_workers
     from ..scenarios.pool_mc import pool_monte_carlo
 
     with executor_of(args) as ex:
         where = (f"on the cluster at {args.scheduler}" if args.scheduler else
-                 f"on {args.workers} local worker processes" if args.workers else "in-process")
+                 f"on {processes(args)} local worker processes" if args.workers else
+                 "in-process")
+        chunk, why = tasks_for(args.monte_carlo, args.mc_chunk,
+                               args.workers or (0 if ex is None else executor_workers(ex)),
+                               local=not args.scheduler)
         print(f"pool Monte Carlo: {args.monte_carlo} simulated missions (outlier probability "
-              f"0.05 per ping), q = {args.q}, m = {args.m}, chunks of {args.mc_chunk} "
-              f"missions, {where}")
+              f"0.05 per ping), q = {args.q}, m = {args.m}, chunks of {chunk} "
+              f"missions{f' ({why})' if why else ''}, {where}")
         mc = pool_monte_carlo(args.monte_carlo, args.q, args.m, seed=args.mc_seed,
-                              chunk=args.mc_chunk, executor=ex, progress=None,
+                              chunk=chunk, executor=ex, progress=None,
                               sweeps=0 if args.sweeps is None else args.sweeps,
                               carry=not args.window_only, paving=args.paving,
                               paving_heading=args.paving_heading,
@@ -171,6 +199,7 @@ def add_options(p: argparse.ArgumentParser) -> None:
                    help="with --monte-carlo: run on K >= 1 local worker processes (workers "
                    "whose chunks would not fit in memory are refused)")
     p.add_argument("--mc-chunk", type=whole(1), metavar="C",
-                   help=f"with --monte-carlo: missions per task, >= 1 (default {DEFAULT_CHUNK})")
+                   help=f"with --monte-carlo: missions per task, >= 1 (default {DEFAULT_CHUNK}); "
+                   "cut smaller when that leaves a worker without a task, and said so")
     p.add_argument("--mc-seed", type=whole(0), help="with --monte-carlo: seed of the first "
                    "mission, >= 0 (default 0)")
