@@ -165,8 +165,9 @@ def test_a_command_that_fails_leaves_no_figure_process(tmp_path, monkeypatch, si
                         lambda self: started.append(self.forked) or self)
 
     before = _children()
-    assert main(["run", "range-only", "--data", str(tmp_path / "missing.csv"), "--out",
-                 str(tmp_path)]) == 2
+    bad = tmp_path / "bad.csv"  # read once the command runs (a missing file: refused before)
+    bad.write_text("i,beacon,t_lo,t_hi,z_lo,z_hi\n1,alpha,nan,1,1,2\n")
+    assert main(["run", "range-only", "--data", str(bad), "--out", str(tmp_path)]) == 2
     assert started == [True]  # the command did fork its figure processes
     end = time.monotonic() + 5
     while _children() - before and time.monotonic() < end:

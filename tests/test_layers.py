@@ -26,7 +26,8 @@ LAYERS: list[set[str]] = [
     {"scenarios"},
     {"plot"},
     {"commands"},
-    {"cli", ""},  # "" is the package's own __init__: the lazy facade over every layer
+    {"cli", "", "__main__"},  # "": the package's own __init__, the lazy facade over every
+    # layer; __main__: ``python -m boundest``, the command line
     {"_kernels_build"},
 ]
 

@@ -41,17 +41,31 @@ def test_scheduler_without_distributed_is_one_sentence(monkeypatch, tmp_path, ca
 
 
 @pytest.mark.parametrize("argv, says", [
-    (["--scheduler", "tcp://127.0.0.1:1"], "go with --monte-carlo"),
+    (["--scheduler", "tcp://127.0.0.1:1"], "--scheduler goes with --monte-carlo"),
+    (["--mc-chunk", "5", "--mc-seed", "1"], "--mc-chunk and --mc-seed go with --monte-carlo"),
     (["--monte-carlo", "10", "--workers", "2", "--scheduler", "x"], "not both"),
-    (["--monte-carlo", "0"], "at least 1 mission"),
-    (["--monte-carlo", "10", "--workers", "0"], "--workers must be at least 1"),
     (["--monte-carlo", "10", "--online"], "does not take --online"),
-    (["--monte-carlo", "10", "--paving-heading", "0"], "paving_heading precision"),
     (["--monte-carlo", "10", "--paving-heading", "0.1", "--window-only"], "recursive observer"),
 ])
 def test_bad_monte_carlo_options(argv, says, tmp_path, capsys):
     assert main(["run", "pool", *argv, "--out", str(tmp_path)]) == 2
-    assert says in capsys.readouterr().err
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and says in err[0], err
+
+
+@pytest.mark.parametrize("argv, says", [
+    (["--monte-carlo", "0"], "argument --monte-carlo: must be a whole number >= 1, got '0'"),
+    (["--monte-carlo", "10", "--workers", "0"], "argument --workers: must be a whole number >= 1"),
+    (["--monte-carlo", "10", "--mc-chunk", "0"], "argument --mc-chunk: must be a whole number"),
+    (["--monte-carlo", "10", "--mc-seed", "-1"], "argument --mc-seed: must be a whole number >= 0"),
+    (["--monte-carlo", "10", "--paving-heading", "0"],
+     "argument --paving-heading: must be a finite number > 0, got '0'"),
+])
+def test_monte_carlo_values_out_of_range_are_parse_errors(argv, says, tmp_path, capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["run", "pool", *argv, "--out", str(tmp_path)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert exc.value.code == 2 and len(err) == 1 and says in err[0], err
 
 
 def test_wilson_interval_known_values():

@@ -17,6 +17,7 @@ import sys
 
 from . import __version__
 from .commands import SCENARIOS, save_figure, subplots, write_json
+from .commands.options import Parser, check_outputs
 
 #: Measured empty-cache first run of each command without the shipped kernel archive
 #: (``BOUNDEST_KERNEL_ARCHIVE=0``, ``benchmarks/bench_startup.py``, a quiet 2-core machine,
@@ -79,17 +80,18 @@ def build_parser(argv: list[str] | None = None) -> argparse.ArgumentParser:
         listed by name and help only. Without ``argv`` every scenario module is imported.
     """
     chosen = _scenario_named(argv)
-    parser = argparse.ArgumentParser(
+    parser = Parser(
         prog="boundest",
         description="Guaranteed nonlinear state estimation by interval constraint propagation.")
     parser.add_argument("--version", action="version", version=f"boundest {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     demo = sub.add_parser("demo", help="enclose the graph of a function with interval boxes "
                                        "and draw it")
-    demo.add_argument("--out", default="out", help="folder for figures (default: out)")
-    demo.add_argument("--json", help="also write the summary as JSON to this file "
-                                     "(strict JSON: docs/json.md)")
-    demo.set_defaults(func=_demo)
+    demo.add_argument("--out", default="out", help="folder for figures, created if missing "
+                                                   "(default: out)")
+    demo.add_argument("--json", help="also write the summary as JSON to this file, in an "
+                                     "existing folder (strict JSON: docs/json.md)")
+    demo.set_defaults(func=_demo, check=lambda a: check_outputs(a.out, a.json))
 
     run = sub.add_parser("run", help="run a seed scenario end to end on its embedded data")
     scen = run.add_subparsers(dest="scenario", required=True)
@@ -109,6 +111,15 @@ def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``boundest`` console script."""
     argv = sys.argv[1:] if argv is None else list(argv)
     args = build_parser(argv).parse_args(argv)
+    try:
+        # the command's own checks, before any work: options that cannot go together, output
+        # paths, inputs, optional extras, the size of the run (commands/options.py)
+        check = getattr(args, "check", None)
+        if check is not None:
+            check(args)
+    except (ValueError, OSError) as exc:
+        print(f"boundest: error: {exc}", file=sys.stderr)
+        return 2
     from ._kernels import announce_compilation
     from ._malloc import keep_freed_memory
 

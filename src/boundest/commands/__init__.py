@@ -133,10 +133,10 @@ def dumps(data: Any) -> str:
 
 
 def write_json(data: dict, path: str | None) -> None:
-    """Write ``data`` as strict JSON (:func:`dumps`) to ``path`` (if given), creating its
-    folder."""
+    """Write ``data`` as strict JSON (:func:`dumps`) to ``path`` (if given), in an existing
+    folder: a command checks ``--json`` before it starts (``options.check_outputs``), and no
+    folder is created for it."""
     if path:
         text = dumps(data)
-        Path(path).parent.mkdir(parents=True, exist_ok=True)
         Path(path).write_text(text + "\n")
         print(f"wrote {path}")

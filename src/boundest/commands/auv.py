@@ -9,6 +9,28 @@ from pathlib import Path
 
 from . import save_figure, subplots, write_json
 from .figures import FigureWorker
+from .options import check_input, check_outputs, fraction, whole
+
+
+def check(args: argparse.Namespace) -> None:
+    """The checks before any work: paths, and the SLAM options only with the SLAM."""
+    check_input("--data", args.data, "folder")
+    check_outputs(args.out, args.json,
+                  () if args.json is None else (("--json", str(_npz(args.json))),))
+    if args.mode == "localization":
+        given = [f"{o} {v:g}" for o, v in (("--rel-eps", args.rel_eps),
+                                           ("--max-iter", args.max_iter)) if v is not None]
+        if given:
+            raise ValueError(f"{' and '.join(given)}: the SLAM's iterations (--mode slam); "
+                             "--mode localization is one forward and one backward pass, with no "
+                             "iterations to stop")
+    args.rel_eps = 1e-4 if args.rel_eps is None else args.rel_eps
+    args.max_iter = 100 if args.max_iter is None else args.max_iter
+
+
+def _npz(json: str) -> Path:
+    """The file of every sample's position box that goes with ``--json FILE``."""
+    return Path(json).with_suffix(".npz")
 
 
 def _summary(res, data) -> None:
@@ -48,7 +70,6 @@ def to_json(res, data, npz: Path | None) -> dict:
     if npz is not None:
         import numpy as np
 
-        npz.parent.mkdir(parents=True, exist_ok=True)
         np.savez_compressed(npz, t=data.t, lo=res.positions.lo, hi=res.positions.hi)
         print(f"wrote {npz}")
     return out
@@ -84,7 +105,7 @@ def _run(args: argparse.Namespace, figures: FigureWorker) -> int:
     for draw in (draw_map, draw_depth, draw_widths):  # the slowest first
         figures.submit(draw, data, results, args.out)
     if args.json:
-        npz = Path(args.json).with_suffix(".npz")
+        npz = _npz(args.json)
         write_json(to_json(final, data, npz), args.json)
     figures.finish()
     return 0 if final.consistent else 1
@@ -134,11 +155,14 @@ def register(runs: argparse._SubParsersAction) -> None:
                         "default)")
     p.add_argument("--data", help="folder holding auv_setup.json and the files it names "
                    "(default: the embedded survey; docs/data-format.md)")
-    p.add_argument("--rel-eps", type=float, default=1e-4,
+    p.add_argument("--rel-eps", type=fraction, default=None,
                    help="SLAM stops when no domain shrinks by more than this fraction in an "
-                        "iteration (default 1e-4)")
-    p.add_argument("--max-iter", type=int, default=100, help="SLAM iteration limit (default 100)")
-    p.add_argument("--out", default="out", help="folder for figures (default: out)")
+                        "iteration, in [0, 1[ (default 1e-4; --mode slam only)")
+    p.add_argument("--max-iter", type=whole(1), default=None,
+                   help="SLAM iteration limit, >= 1 (default 100; --mode slam only)")
+    p.add_argument("--out", default="out", help="folder for figures, created if missing "
+                   "(default: out)")
     p.add_argument("--json", help="write the summary, mines and detections as JSON to this file "
-                   "and the position box of every sample to FILE.npz (docs/json.md)")
-    p.set_defaults(func=run)
+                   "and the position box of every sample to FILE.npz, in an existing folder "
+                   "(docs/json.md)")
+    p.set_defaults(func=run, check=check)

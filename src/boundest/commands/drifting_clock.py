@@ -3,9 +3,47 @@
 from __future__ import annotations
 
 import argparse
+import math
+from collections.abc import Callable
 
 from . import save_figure, subplots, write_json
 from .figures import FigureWorker
+from .options import check_input, check_outputs, check_size, count, fraction, positive_float
+
+DEFAULT_DT = 0.01
+#: Memory of a run per slice: the peak resident memory of the command grew by 1.8 KiB per slice
+#: from ``--dt 0.01`` to ``--dt 0.0001``, its figure process by 0.55 KiB, the ``--json`` text by
+#: 0.4 KiB (2026-12, the development machine); rounded up
+BYTES_PER_SLICE = 3 * 1024
+#: The rest: the interpreter, the libraries and the figure process (0.28 GiB at ``--dt 0.01``)
+BASE_BYTES = 300 << 20
+#: More slices than this (80 times the default's 1244 on Table 2) are announced before the run
+LARGE_SLICES = 100_000
+
+
+def check(args: argparse.Namespace) -> None:
+    """The checks before any work (the size ``--dt`` sets depends on the data: see
+    :func:`check_slices`)."""
+    check_input("--data", args.data)
+    check_outputs(args.out, args.json)
+
+
+def check_slices(t_final: Callable[[float], float], dt: float) -> None:
+    """Refuse or announce the run whose tubes cover ``[0, t_final(dt)]`` at step ``dt``
+    (``t_final(step)``: the end of the time domain the data need, a multiple of ``step``:
+    ``boundest.scenarios.drifting_clock.t_final``)."""
+    def slices(step: float) -> float:
+        try:
+            return max(1, round(t_final(step) / step))
+        except OverflowError:  # a step so small that the count overflows a float
+            return math.inf
+
+    n = slices(dt)
+    span = f" over [0, {n * dt:.6g}] s" if math.isfinite(n) else ""
+    check_size(BASE_BYTES + n * BYTES_PER_SLICE,
+               f"{count(n)} slices{span}, {count(n / slices(DEFAULT_DT))} times the default "
+               f"--dt {DEFAULT_DT:g}'s, in every tube", f"--dt {dt:g}",
+               large=n > LARGE_SLICES)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -20,6 +58,7 @@ def _run(args: argparse.Namespace, figures: FigureWorker) -> int:
     from ..scenarios import drifting_clock as dc
 
     meas = dc.load(args.data)
+    check_slices(lambda step: dc.t_final(meas, step=step), args.dt)
     print(f"drifting clock (Rohou et al. 2018): {len(meas)} measurements, data {meas.source}")
     res = dc.solve(meas, dt=args.dt, rel_eps=args.rel_eps, time_deriv=not args.plain_eval)
     if res.empty:
@@ -72,16 +111,20 @@ def draw_figure(name: str, res, truth, out: str) -> None:
 def register(runs: argparse._SubParsersAction) -> None:
     """Add ``boundest run drifting-clock`` and its options."""
     p = runs.add_parser("drifting-clock", help="Rohou et al. 2018: correcting a drifting clock")
-    p.add_argument("--dt", type=float, default=0.01, help="slice duration (default 0.01)")
+    p.add_argument("--dt", type=positive_float, default=DEFAULT_DT,
+                   help="slice duration in seconds, > 0 (default 0.01: 1244 slices on Table 2); "
+                        "a run that needs more memory than the machine has is refused, one of "
+                        f"more than {LARGE_SLICES:,} slices announced")
     p.add_argument("--data", help="measurement CSV, columns i,tau,z_lo,z_hi (default: the "
                    "embedded Table 2; docs/data-format.md)")
-    p.add_argument("--rel-eps", type=float, default=1e-4,
-                   help="stop when an iteration shrinks the domains by less than this fraction "
-                        "(default 1e-4)")
+    p.add_argument("--rel-eps", type=fraction, default=1e-4,
+                   help="stop when an iteration shrinks the domains by less than this fraction, "
+                        "in [0, 1[ (default 1e-4)")
     p.add_argument("--plain-eval", action="store_true",
                    help="contract the [t_i] with the plain tube inverse (whole slices) instead "
                         "of the derivative inside the slices (the default)")
-    p.add_argument("--out", default="out", help="folder for figures (default: out)")
-    p.add_argument("--json", help="write [h], [y] and the [t_i] as JSON to this file "
-                   "(strict JSON: docs/json.md)")
-    p.set_defaults(func=run)
+    p.add_argument("--out", default="out", help="folder for figures, created if missing "
+                   "(default: out)")
+    p.add_argument("--json", help="write [h], [y] and the [t_i] as JSON to this file, in an "
+                   "existing folder (strict JSON: docs/json.md)")
+    p.set_defaults(func=run, check=check)

@@ -18,6 +18,12 @@ from pathlib import Path
 
 from . import save_figure, subplots, write_json
 from .figures import FigureWorker
+from .options import check_input, check_outputs, check_size, positive_float, whole
+
+#: ``boundest.scenarios.pool.DEFAULT_SLICES`` and ``pool_observer.MAX_SIDE``, spelt out here so
+#: that the checks import nothing numerical (``tests/test_bad_input.py`` checks that they agree)
+DEFAULT_SLICES = 32
+MAX_SIDE = 64
 
 GUARANTEE = {
     True: ("the probability that one window of {m} pings holds at most {q} outliers; the "
@@ -61,16 +67,63 @@ def _mean_widths(res) -> tuple:
     return (w[ok].mean(axis=0) if ok.any() else np.full(4, np.nan)), int(ok.sum())
 
 
-def run(args: argparse.Namespace) -> int:
-    if args.q < 0 or args.m < 1:
-        raise ValueError(f"need --q >= 0 and --m >= 1, got --q {args.q} --m {args.m}")
+def observer_bytes(m: int, slices: int) -> int:
+    """The memory of one mission's observer (``pool_observer.make_work``, ``make_bank``): two
+    ``(m, m, 4)`` arrays of the window's smoothing, and four ``(2 slices, m, 4)`` arrays of the
+    heading slices' windows, in float64."""
+    return 64 * m * m + 256 * slices * m
+
+
+#: The rest of a run on one mission (the interpreter, the libraries, the figure process: 0.35
+#: GiB on the embedded mission)
+BASE_BYTES = 400 << 20
+
+
+def check(args: argparse.Namespace) -> None:
+    """The checks before any work: options that go together, paths, and the memory --m and
+    --heading-slices set (the Monte Carlo's own: ``pool_mc.check``)."""
+    if args.q > args.m:
+        raise ValueError(f"--q {args.q} outliers cannot be more than the --m {args.m} pings of "
+                         "a window")
     if args.heading_slices is not None and args.paving_heading is None:
-        raise ValueError("--heading-slices N goes with --paving-heading RAD")
-    if args.monte_carlo is not None or args.scheduler or args.workers is not None:
+        raise ValueError(f"--heading-slices {args.heading_slices} goes with --paving-heading "
+                         "RAD (it bounds the heading slices, and there are none)")
+    if args.paving_heading is not None and args.window_only:
+        raise ValueError("--paving-heading keeps heading slices that carry their own past: it "
+                         "needs the recursive observer, not --window-only")
+    monte_carlo = [o for o, v in (("--scheduler", args.scheduler), ("--workers", args.workers),
+                                  ("--mc-chunk", args.mc_chunk), ("--mc-seed", args.mc_seed))
+                   if v is not None]
+    if args.monte_carlo is None and monte_carlo:
+        raise ValueError(f"{' and '.join(monte_carlo)} "
+                         f"{'go' if len(monte_carlo) > 1 else 'goes'} with --monte-carlo N: "
+                         "without it there are no missions to simulate")
+    if args.monte_carlo is not None:
+        from .pool_mc import check as check_monte_carlo
+
+        check_monte_carlo(args)
+        return
+    check_input("--data", args.data, "folder")
+    check_outputs(args.out, args.json)
+    slices = heading_slices(args)
+    check_size(BASE_BYTES + observer_bytes(args.m, slices),
+               f"the observer's windows of {args.m} pings"
+               + (f" in {slices} heading slices" if args.paving_heading is not None else ""),
+               f"--m {args.m}" + (f" --heading-slices {slices}"
+                                  if args.paving_heading is not None else ""))
+
+
+def heading_slices(args: argparse.Namespace) -> int:
+    """The heading slices the observer keeps room for (1 without --paving-heading)."""
+    if args.paving_heading is None:
+        return 1
+    return DEFAULT_SLICES if args.heading_slices is None else args.heading_slices
+
+
+def run(args: argparse.Namespace) -> int:
+    if args.monte_carlo is not None:
         from .pool_mc import run_monte_carlo
 
-        if args.monte_carlo is None:
-            raise ValueError("--scheduler and --workers go with --monte-carlo N")
         return run_monte_carlo(args)
     with FigureWorker(preload=("boundest.plot.pool", "boundest.scenarios.pool")) as figures:
         return _run(args, figures)
@@ -245,8 +298,6 @@ def _mode_line(sweeps: int, paving: float | None, heading: float | None) -> str:
 
 def _heading_slices(args: argparse.Namespace) -> int:
     """The most heading slices this run keeps (``--heading-slices``, else the default)."""
-    from ..scenarios.pool import DEFAULT_SLICES
-
     return DEFAULT_SLICES if args.heading_slices is None else args.heading_slices
 
 
@@ -286,24 +337,27 @@ def register(runs: argparse._SubParsersAction) -> None:
     """Add ``boundest run pool`` and its options."""
     p = runs.add_parser("pool", help="pool robot (Jaulin's robust set-membership observer): "
                                      "a recursive q-relaxed observer over sonar pings")
-    p.add_argument("--q", type=int, default=8,
-                   help="outliers allowed in a window (default 8)")
-    p.add_argument("--m", type=int, default=80,
-                   help="window length in pings (default 80: one sonar revolution)")
-    p.add_argument("--sweeps", type=int,
-                   help="smoothing rounds inside the window per ping (default 1, with "
+    p.add_argument("--q", type=whole(0), default=8,
+                   help="outliers allowed in a window, 0 <= q <= m (default 8)")
+    p.add_argument("--m", type=whole(1), default=80,
+                   help="window length in pings, >= 1 (default 80: one sonar revolution; the "
+                   "observer holds two m x m arrays: a window too long for the memory is "
+                   "refused)")
+    p.add_argument("--sweeps", type=whole(0),
+                   help="smoothing rounds inside the window per ping, >= 0 (default 1, with "
                    "--monte-carlo 0; 0: the plain recursive box observer, about 50x faster "
                    "and wider)")
-    p.add_argument("--paving", type=float, metavar="EPS",
-                   help="pave (x, y) of each set into cells of side EPS metres and keep the "
-                   "hull of the cells whose window is consistent (tighter, slower)")
-    p.add_argument("--paving-heading", type=float, metavar="RAD",
+    p.add_argument("--paving", type=positive_float, metavar="EPS",
+                   help="pave (x, y) of each set into cells of side EPS > 0 metres, at most "
+                   f"{MAX_SIDE} cells a side (a smaller EPS gives {MAX_SIDE} cells), and keep "
+                   "the hull of the cells whose window is consistent (tighter, slower)")
+    p.add_argument("--paving-heading", type=positive_float, metavar="RAD",
                    help="keep the set as heading slices, each with its own window, cut in two "
-                   "when wider than RAD radians (what pays most: e.g. 0.01; recursive "
-                   "observer only)")
-    p.add_argument("--heading-slices", type=int, metavar="N",
-                   help="most heading slices kept with --paving-heading (default 32; beyond "
-                   "it neighbours merge)")
+                   "when wider than RAD > 0 radians (what pays most: e.g. 0.01; recursive "
+                   "observer only, not with --window-only)")
+    p.add_argument("--heading-slices", type=whole(1), metavar="N",
+                   help="most heading slices kept with --paving-heading, >= 1 (default 32; "
+                   "beyond it neighbours merge)")
     p.add_argument("--window-only", action="store_true",
                    help="the pure window observer: each set from the open-loop prior and the "
                    "window's pings alone (its per-step guarantee is the binomial bound)")
@@ -311,11 +365,11 @@ def register(runs: argparse._SubParsersAction) -> None:
                    help="run the online interface (one update per ping) and time each update")
     p.add_argument("--data", help="folder holding pool_setup.json, pool_map.json and the files "
                    "the setup names (default: the embedded mission; docs/data-format.md)")
-    p.add_argument("--out", default="out", help="folder for figures and pool_table.txt "
-                   "(default: out)")
-    p.add_argument("--json", help="write the summary and every step's box as JSON to this file "
-                   "(strict JSON: docs/json.md)")
+    p.add_argument("--out", default="out", help="folder for figures and pool_table.txt, "
+                   "created if missing (default: out)")
+    p.add_argument("--json", help="write the summary and every step's box as JSON to this file, "
+                   "in an existing folder (strict JSON: docs/json.md)")
     from .pool_mc import add_options
 
     add_options(p)
-    p.set_defaults(func=run)
+    p.set_defaults(func=run, check=check)

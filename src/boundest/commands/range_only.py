@@ -3,9 +3,52 @@
 from __future__ import annotations
 
 import argparse
+import math
 
 from . import save_figure, subplots, write_json
 from .figures import FigureWorker
+from .options import (
+    check_input,
+    check_outputs,
+    check_size,
+    count,
+    fraction,
+    positive_float,
+    whole,
+)
+
+#: ``boundest.scenarios.range_only.TF - T0``, the time domain that ``--dt`` slices, spelt out here
+#: so that the checks import nothing numerical (``tests/test_bad_input.py`` checks that they
+#: agree)
+HORIZON_S = 64.0
+DEFAULT_DT = 0.01
+#: Memory of a run per slice: the peak resident memory of the command (``--max-iter 1``) grew by
+#: 3.6 KiB per slice from ``--dt 0.01`` to ``--dt 0.001``, its figure process by 1.1 KiB, the
+#: ``--json`` text by 1.0 KiB (2026-12, the development machine); rounded up
+BYTES_PER_SLICE = 6 * 1024
+#: The rest: the interpreter, the libraries and the figure process (0.3 GiB at ``--dt 0.01``)
+BASE_BYTES = 350 << 20
+#: More slices than this (16 times the default's 6400) are announced before the run starts
+LARGE_SLICES = 100_000
+
+
+def slices(dt: float) -> float:
+    """Slices of the tubes over the time domain at step ``dt`` (as ``tube.time_grid``): a whole
+    number, or ``inf`` when ``dt`` is so small that their number overflows a float."""
+    n = HORIZON_S / dt * (1 - 1e-12)
+    return max(1, math.ceil(n)) if math.isfinite(n) else math.inf
+
+
+def check(args: argparse.Namespace) -> None:
+    """The checks before any work: inputs, outputs, and the size ``--dt`` sets."""
+    check_input("--data", args.data)
+    check_input("--beacons", args.beacons)
+    check_outputs(args.out, args.json)
+    n = slices(args.dt)
+    check_size(BASE_BYTES + n * BYTES_PER_SLICE,
+               f"{count(n)} slices over [0, {HORIZON_S:g}] s, {count(n / slices(DEFAULT_DT))} "
+               f"times the default --dt {DEFAULT_DT:g}'s, in every tube", f"--dt {args.dt:g}",
+               large=n > LARGE_SLICES)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -20,7 +63,7 @@ def _run(args: argparse.Namespace, figures: FigureWorker) -> int:
     from ..scenarios import range_only as ro
 
     meas = ro.load(args.data, args.beacons)
-    n = int(np.ceil((ro.TF - ro.T0) / args.dt))
+    n = slices(args.dt)
     print(f"range-only robot (Rohou et al. 2018): {len(meas)} measurements, "
           f"{meas.beacons.shape[0]} beacons, data {meas.source}")
     print(f"tubes over [{ro.T0:g}, {ro.TF:g}] with dt = {args.dt:g} ({n} slices) ...",
@@ -80,21 +123,26 @@ def register(runs: argparse._SubParsersAction) -> None:
     """Add ``boundest run range-only`` and its options."""
     p = runs.add_parser("range-only",
                         help="Rohou et al. 2018: range-only robot with uncertain times")
-    p.add_argument("--dt", type=float, default=0.01, help="slice duration (default 0.01)")
+    p.add_argument("--dt", type=positive_float, default=DEFAULT_DT,
+                   help="slice duration in seconds, > 0 (default 0.01: 6400 slices); a run that "
+                        "needs more memory than the machine has is refused, one of more than "
+                        f"{LARGE_SLICES:,} slices announced")
     p.add_argument("--data", help="measurement CSV, columns i,beacon,t_lo,t_hi,z_lo,z_hi "
                    "(default: the embedded Table 1; docs/data-format.md)")
     p.add_argument("--beacons", help="beacon CSV, columns beacon,bx,by (default: the embedded one)")
-    p.add_argument("--rel-eps", type=float, default=1e-4,
-                   help="stop when an iteration shrinks the domains by less than this fraction "
-                        "(default 1e-4)")
-    p.add_argument("--max-iter", type=int, default=200, help="iteration limit (default 200)")
+    p.add_argument("--rel-eps", type=fraction, default=1e-4,
+                   help="stop when an iteration shrinks the domains by less than this fraction, "
+                        "in [0, 1[ (default 1e-4)")
+    p.add_argument("--max-iter", type=whole(1), default=200,
+                   help="iteration limit, >= 1 (default 200)")
     p.add_argument("--time-deriv-eval", action="store_true",
                    help="contract the measurement times with the derivative inside the slices "
                         "(default: the plain tube inverse; the same result on Table 1)")
     p.add_argument("--bearing-rate", action="store_true",
                    help="constrain the distance rate in its bearing form only, as Rohou et al. "
                         "2018 and Codac (cheaper, wider; default: also the product form)")
-    p.add_argument("--out", default="out", help="folder for figures (default: out)")
-    p.add_argument("--json", help="write the tubes and measurement boxes as JSON to this file "
-                   "(strict JSON: docs/json.md)")
-    p.set_defaults(func=run)
+    p.add_argument("--out", default="out", help="folder for figures, created if missing "
+                   "(default: out)")
+    p.add_argument("--json", help="write the tubes and measurement boxes as JSON to this file, "
+                   "in an existing folder (strict JSON: docs/json.md)")
+    p.set_defaults(func=run, check=check)

@@ -6,6 +6,13 @@ import argparse
 
 from . import save_figure, subplots, write_json
 from .figures import FigureWorker
+from .options import check_input, check_outputs, fraction
+
+
+def check(args: argparse.Namespace) -> None:
+    """The checks before any work: the input and output paths."""
+    check_input("--data", args.data)
+    check_outputs(args.out, args.json)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -25,9 +32,11 @@ def _run(args: argparse.Namespace, figures: FigureWorker) -> int:
     res = sat.solve(meas, rel_eps=args.rel_eps, mode=args.mode)
     if not res.consistent and args.beta_tuning:
         print("the CSP is empty: the data contradict the model; beta-tuning ...")
-        bres, res = sat.tune(meas, rel_eps=args.rel_eps)
-        print(f"smallest beta with a non-empty contraction: {bres.beta:.4f} "
-              f"({len(bres.trials)} propagations, {bres.time_s:.2f} s)")
+        bres, res = sat.tune(meas, rel_eps=args.rel_eps, mode=args.mode)
+        how = ("bisection by hull consistency" if args.mode == "hc4" else
+               f"bisection by hull consistency, then mode {args.mode} from its beta on")
+        print(f"smallest beta with a non-empty contraction in mode {args.mode}: "
+              f"{bres.beta:.4f} ({len(bres.trials)} propagations, {how}, {bres.time_s:.2f} s)")
     if not res.consistent:
         print("proven INCONSISTENT: no state trajectory satisfies the model and the data "
               "(rerun with --beta-tuning to relax the perturbation and output bounds)")
@@ -92,17 +101,20 @@ def register(runs: argparse._SubParsersAction) -> None:
     sat.add_argument("--data", help="measurement CSV, columns k,y1_lo,y1_hi,y2_lo,y2_hi,"
                                     "y3_lo,y3_hi (default: the embedded one for --kmax; "
                                     "docs/data-format.md)")
-    sat.add_argument("--rel-eps", type=float, default=1e-3,
+    sat.add_argument("--rel-eps", type=fraction, default=1e-3,
                      help="propagation stops when no domain shrinks by more than this "
-                          "fraction of its width (default 1e-3)")
+                          "fraction of its width, in [0, 1[ (default 1e-3)")
     sat.add_argument("--mode", choices=("3b+centered", "3b", "hc4"), default="3b+centered",
                      help="3b+centered (default): hull consistency, 3B shaving of the states, "
                           "then the centered form of windows of steps (tightest); 3b: shaving "
                           "alone; hc4: hull consistency alone (fastest); "
                           "benchmarks/README.md compares them")
     sat.add_argument("--beta-tuning", action="store_true",
-                     help="if the CSP is empty, search the smallest relaxation beta")
-    sat.add_argument("--out", default="out", help="folder for figures (default: out)")
-    sat.add_argument("--json", help="write the enclosures as JSON to this file "
-                   "(strict JSON: docs/json.md)")
-    sat.set_defaults(func=run)
+                     help="if the CSP is empty, search the smallest relaxation beta for which "
+                          "--mode does not prove it empty (a bisection by hull consistency, "
+                          "then in --mode from its result)")
+    sat.add_argument("--out", default="out", help="folder for figures, created if missing "
+                                                  "(default: out)")
+    sat.add_argument("--json", help="write the enclosures as JSON to this file, in an existing "
+                                    "folder (strict JSON: docs/json.md)")
+    sat.set_defaults(func=run, check=check)

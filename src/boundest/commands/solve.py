@@ -15,6 +15,16 @@ from pathlib import Path
 from typing import Any
 
 from . import save_figure, subplots, write_json
+from .options import (
+    announce,
+    check_input,
+    check_outputs,
+    check_size,
+    fraction,
+    positive_float,
+    require_extra,
+    whole,
+)
 
 #: ``boundest.csp.MODES``, spelt out here so that ``boundest --help`` does not import Numba
 #: (``tests/test_solve_cli.py`` checks that the two agree)
@@ -23,6 +33,24 @@ PROPAGATION_MODES = ("hc4", "bc", "3b", "bc+3b", "lp", "centered", "3b+centered"
 #: Subpavings are computed for models of at most this many variables (SIVIA bisects every
 #: dimension; beyond a few the number of boxes explodes).
 MAX_PAVING_VARIABLES = 12
+DEFAULT_MAX_BOXES = 100_000
+
+
+def paving_bytes(boxes: int, variables: int, json: bool) -> float:
+    """The memory a subpaving of ``boxes`` boxes may take: each box's bounds (16 bytes a
+    variable) about four times over (the frontier, its bisection, the kept boxes and their
+    concatenation), and with ``--json`` its text and Python floats (about 150 bytes a
+    variable), plus 0.3 GiB for the interpreter and the libraries."""
+    return (300 << 20) + boxes * variables * (64 + (150 if json else 0))
+
+
+def check(args: argparse.Namespace) -> None:
+    """The checks before any work: the model file, the outputs, the extra --mode lp needs.
+    Those that depend on the model (--paving, --max-boxes) follow its loading (:func:`run`)."""
+    check_input("model file", args.file)
+    check_outputs(args.out, args.json)
+    if args.mode == "lp":
+        require_extra("--mode lp", "scipy.optimize", "lp", "SciPy (linear programming)")
 _FAMILY = re.compile(r"^(.*?)_?(\d+)$")
 
 
@@ -199,17 +227,44 @@ def _phases(res: Any) -> str:
     return "; of which " + ", ".join(parts) if parts else ""
 
 
+def _paving_of(model: Any, args: argparse.Namespace) -> float | None:
+    """The paving precision of this run (None: propagation only), after the checks that need
+    the model: ``--max-boxes`` only with a paving, at most :data:`MAX_PAVING_VARIABLES`
+    variables for SIVIA, the memory ``--max-boxes`` allows; ``--paving`` overriding the file's
+    ``Bisection`` says so."""
+    eps = header_paving(model, args.file)
+    if args.paving is not None:
+        if eps is not None:
+            line = model.option_lines.get(next(k for k in model.options
+                                               if k.lower() == "bisection"), "?")
+            announce(f"--paving {args.paving:g} overrides 'Bisection {eps:g};' of "
+                     f"{args.file}:{line}")
+        eps = args.paving
+    if eps is None:
+        if args.max_boxes is not None:
+            raise ValueError(f"--max-boxes {args.max_boxes} bounds a subpaving, and there is "
+                             "none: give --paving EPS (or 'Bisection EPS;' in the file)")
+        return None
+    if args.max_boxes is None:
+        args.max_boxes = DEFAULT_MAX_BOXES
+    n = len(model.domains)
+    if n > MAX_PAVING_VARIABLES and not is_square(model):
+        raise ValueError(f"a subpaving is computed for at most {MAX_PAVING_VARIABLES} variables; "
+                         f"the model has {n} (propagation alone: 'Bisection none;' or no "
+                         "--paving)")
+    check_size(paving_bytes(args.max_boxes, n, args.json is not None),
+               f"a subpaving of up to {args.max_boxes:,} boxes of {n} variables",
+               f"--max-boxes {args.max_boxes}")
+    return eps
+
+
 def run(args: argparse.Namespace) -> int:
     """``boundest solve``: propagate, print the summary (every domain with ``--all``), pave."""
     from ..csp import propagate
     from ..expr import load_model
 
     model = load_model(args.file)
-    eps = header_paving(model, args.file)
-    if args.paving is not None:
-        if not args.paving > 0.0:
-            raise ValueError(f"--paving must be a positive precision, got {args.paving}")
-        eps = args.paving
+    eps = _paving_of(model, args)
     res = propagate(model, rel_eps=args.rel_eps, mode=args.mode)
     status = "consistent" if res.consistent else "INCONSISTENT (no solution)"
     print(f"{args.file}: {len(model.domains)} variables, {len(model.constraints)} constraints: "
@@ -292,27 +347,31 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("solve", help="propagate a model file; print a summary of the domains "
                                      "(and a subpaving with --paving)")
     p.add_argument("file", help="model in the text format (docs/model-format.md)")
-    p.add_argument("--rel-eps", type=float, default=1e-3,
+    p.add_argument("--rel-eps", type=fraction, default=1e-3,
                    help="propagation stops when no domain shrinks by more than this fraction "
-                        "of its width (default 1e-3)")
+                        "of its width, in [0, 1[ (default 1e-3)")
     p.add_argument("--mode", choices=PROPAGATION_MODES, default="3b+centered",
                    help="shaving then the centered form of windows of constraints "
                         "(3b+centered, default: the tightest), hull consistency alone (hc4: "
                         "the fastest, 25-900 times cheaper), then box consistency (bc), 3B "
                         "shaving (3b), both (bc+3b), LP contraction (lp, needs the lp extra) "
                         "or the centered form alone (centered); see boundest.csp.propagate "
-                        "and docs/derivatives.md")
+                        "and docs/derivatives.md; without the lp extra, --mode lp is refused "
+                        "before any work")
     p.add_argument("--all", action="store_true",
                    help="print every variable's domain instead of the summary")
-    p.add_argument("--paving", type=float, metavar="EPS",
-                   help="after propagation, bisect with SIVIA to boxes narrower than EPS: an "
-                        f"outer subpaving (for models of at most {MAX_PAVING_VARIABLES} "
-                        "bounded variables; overrides the file's 'Bisection' option); a square "
-                        "system (as many equations as variables, nothing else) is solved by "
-                        "interval Newton instead, which proves solutions")
-    p.add_argument("--max-boxes", type=int, default=100_000,
-                   help="SIVIA stops before exceeding this many boxes (default 100000)")
-    p.add_argument("--out", default="out", help="folder for the subpaving figure (default: out)")
+    p.add_argument("--paving", type=positive_float, metavar="EPS",
+                   help="after propagation, bisect with SIVIA to boxes narrower than EPS > 0: "
+                        f"an outer subpaving (for models of at most {MAX_PAVING_VARIABLES} "
+                        "bounded variables; overrides the file's 'Bisection' option, and says "
+                        "so); a square system (as many equations as variables, nothing else) "
+                        "is solved by interval Newton instead, which proves solutions")
+    p.add_argument("--max-boxes", type=whole(1), default=None,
+                   help="with a paving: it stops before exceeding this many boxes, >= 1 "
+                        "(default 100000); a bound whose subpaving could not fit in memory is "
+                        "refused")
+    p.add_argument("--out", default="out", help="folder for the subpaving figure, created if "
+                                                "missing (default: out)")
     p.add_argument("--json", help="write every domain (and the subpaving's boxes) as JSON to "
-                                  "this file (strict JSON: docs/json.md)")
-    p.set_defaults(func=run)
+                                  "this file, in an existing folder (strict JSON: docs/json.md)")
+    p.set_defaults(func=run, check=check)

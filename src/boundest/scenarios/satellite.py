@@ -305,20 +305,38 @@ def solve(meas: Measurements, rel_eps: float = 1e-3, progress: bool | None = Non
     steps say together); ``mode="3b"`` shaves harder (``SHAVING``) and stops there;
     ``mode="hc4"`` is hull consistency alone.
     """
+    _check_mode(mode)
+    tape = compile_model(build_model(meas))
+    return _result(tape, _propagate(tape, meas.k_max, rel_eps, mode, progress), meas.k_max, 1.0)
+
+
+def _check_mode(mode: str) -> None:
     if mode not in MODES:
         raise ValueError(f"mode must be one of {', '.join(MODES)}, got {mode!r}")
-    tape = compile_model(build_model(meas))
-    names = [v for row in _state_names(meas.k_max) for v in row]
-    prop = propagate(tape, rel_eps=rel_eps, progress=progress, mode=mode, shave=names,
+
+
+def _propagate(tape: Tape, K: int, rel_eps: float, mode: str, progress: bool | None = False):
+    """The propagation of :func:`solve` in ``mode`` (the states shaved and centered)."""
+    names = [v for row in _state_names(K) for v in row]
+    return propagate(tape, rel_eps=rel_eps, progress=progress, mode=mode, shave=names,
                      shaving=SHAVING_CENTERED if mode == "3b+centered" else SHAVING,
                      targets=names, centered=CENTERED)
-    return _result(tape, prop, meas.k_max, 1.0)
 
 
-def tune(meas: Measurements, beta_max: float = 16.0, tol: float = 1e-3, rel_eps: float = 1e-3
-         ) -> tuple[BetaResult, SatelliteResult]:
+def tune(meas: Measurements, beta_max: float = 16.0, tol: float = 1e-3, rel_eps: float = 1e-3,
+         mode: str = "hc4") -> tuple[BetaResult, SatelliteResult]:
     """Beta-tuning (Jaulin 2002 section 5.2): the smallest ``beta`` in ``]0, beta_max]`` for which
-    the contracted CSP is not empty, and the domains at that ``beta``."""
+    the CSP contracted in ``mode`` (as :func:`solve`) is not empty, and the domains at that
+    ``beta``.
+
+    The bisection runs with hull consistency (``"hc4"``), the cheapest mode. Every other mode
+    starts with hull consistency and contracts further, so a ``beta`` at which hull consistency
+    proves the CSP empty is one at which ``mode`` does too: with another ``mode``, the CSP is
+    then propagated in ``mode`` at the ``beta`` found, and when ``mode`` proves it empty there,
+    the bisection goes on in ``mode`` above it. ``BetaResult.trials`` holds every propagation
+    of both searches; the domains returned are ``mode``'s.
+    """
+    _check_mode(mode)
     K = meas.k_max
     tape = compile_model(build_model(meas, beta=beta_max))
     w_slots = np.array([tape.slot_of[f"w{i}_{k}"] for k in range(K + 1) for i in (1, 2, 3, 4)])
@@ -337,6 +355,15 @@ def tune(meas: Measurements, beta_max: float = 16.0, tol: float = 1e-3, rel_eps:
     t0 = time.perf_counter()
     res = beta_tuning(lambda b: propagate(at(b), rel_eps=rel_eps, mode="hc4"),
                       beta_max=beta_max, tol=tol)
+    if mode != "hc4":
+        first = _propagate(at(res.beta), K, rel_eps, mode)
+        trials = [*res.trials, (res.beta, first.consistent)]
+        if first.consistent:
+            res = BetaResult(res.beta, first, trials)
+        else:
+            more = beta_tuning(lambda b: _propagate(at(b), K, rel_eps, mode),
+                               beta_max=beta_max, tol=tol, beta_min=res.beta)
+            res = BetaResult(more.beta, more.propagation, trials + more.trials)
     res.time_s = time.perf_counter() - t0
     return res, _result(tape, res.propagation, K, res.beta)
 
