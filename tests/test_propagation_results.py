@@ -95,3 +95,20 @@ def test_propagate_lp_results_are_indexed_the_same_way():
     res = propagate_lp(m)
     assert res[x[1]] == res["x_1"] == Interval(1, 2)
     assert res.bounds(x)[1].tolist() == [1, 2, 3, 4]
+
+
+def test_shave_and_targets_take_vars_and_families():
+    x = VarFamily("x")
+    m = Model()
+    m.declare(x[0], (-1, 1))
+    m.add(x[k + 1] == x[k] * x[k] - 0.5 for k in range(3))
+    m.add(x[3] >= 0)
+    names = [f"x_{k}" for k in range(4)]
+    by_name = propagate(m, mode="3b", shave=names)
+    for shave in ([x], [x[0], "x_1", x[2], x[3]]):
+        res = propagate(m, mode="3b", shave=shave)
+        assert res.domains == by_name.domains and res.shaving == {**by_name.shaving,
+                                                                 "time_s": res.shaving["time_s"]}
+    assert by_name.shaving["probes"] > 0
+    res = propagate(m, mode="centered", targets=[x[3]])
+    assert res.domains == propagate(m, mode="centered", targets=["x_3"]).domains

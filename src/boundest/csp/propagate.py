@@ -371,8 +371,9 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
               max_evaluations: int | None = None,
               domains: dict[str | Var, Interval] | None = None,
               progress: bool | None = None, chunk: int = 2_000_000, window: int = 64,
-              mode: str | None = None, shave: list[str] | None = None,
-              shaving: Shaving | None = None, targets: list[str] | None = None,
+              mode: str | None = None, shave: list[str | Var | VarFamily] | None = None,
+              shaving: Shaving | None = None,
+              targets: list[str | Var | VarFamily] | None = None,
               boxcons: BoxConsistency | None = None,
               linear: LinearRelaxation | None = None,
               centered: Centered | None = None) -> Propagation:
@@ -445,12 +446,13 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
         centered form, or shaving and the centered form. Default :data:`DEFAULT_MODE`
         (``"3b+centered"``), or ``"3b"`` for a ``Tape`` built without its model (by
         ``expr.tape.instantiate``), which cannot be differentiated.
-    shave : list of str, optional
+    shave : list of str, Var or VarFamily, optional
         With ``mode="3b"``: the variables to shave, in the order they are visited (for a time
-        series, by time step; default: every variable of the model in its order).
+        series, by time step; default: every variable of the model in its order). A
+        ``VarFamily`` stands for its members, in index order; so in ``targets``.
     shaving : Shaving, optional
         With ``mode="3b"``: the shaving settings (default ``Shaving()``).
-    targets : list of str, optional
+    targets : list of str, Var or VarFamily, optional
         With ``mode="bc"`` or ``"bc+3b"``: the variables box consistency narrows (those among
         them that occur several times; default: every variable); with ``mode="lp"``: the
         variables the LPs contract (default: every variable; each costs two LPs, four where it
@@ -471,6 +473,7 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
     if window < 1:
         raise ValueError(f"window must be a positive number of nodes, got {window}")
     tape = model if isinstance(model, Tape) else compile_model(model)
+    shave, targets = _names(tape, shave), _names(tape, targets)
     if mode is None:
         mode = DEFAULT_MODE if tape.model is not None else "3b"
     if mode in ("centered", "3b+centered") and tape.model is None:
@@ -685,6 +688,21 @@ def _centered_rounds(tape: Tape, lo: np.ndarray, hi: np.ndarray, ptr: np.ndarray
                          "min_gain": opts.min_gain},
             "time_s": time.perf_counter() - t0}
     return status, info
+
+
+def _names(tape: Tape, keys: list[str | Var | VarFamily] | None) -> list[str] | None:
+    """The variable names of ``keys``: a ``Var`` by its name, a ``VarFamily`` by its members in
+    the model, in index order."""
+    if keys is None:
+        return None
+    names: list[str] = []
+    for key in keys:
+        if isinstance(key, VarFamily):
+            members = key.members(tape.slot_of)
+            names += [members[k] for k in sorted(members)]
+        else:
+            names.append(key.name if isinstance(key, Var) else key)
+    return names
 
 
 def _shave_slots(tape: Tape, names: list[str] | None, arg: str = "shave") -> np.ndarray:
