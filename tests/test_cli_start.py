@@ -1,5 +1,6 @@
 """``boundest --help`` and argument errors load neither NumPy nor Numba; the parser imports
-only the scenario it runs; a run that compiles says so once on standard error."""
+only the scenario it runs; a run that compiles says so once on standard error, and so does
+library use (through ``logging``)."""
 
 from __future__ import annotations
 
@@ -74,6 +75,63 @@ def test_a_compiling_run_says_so_once_and_a_cached_run_does_not(tmp_path):
         errs.append([line for line in out.stderr.splitlines() if "compiling" in line])
     assert len(errs[0]) == 1 and "boundest solve" in errs[0][0] and "about" in errs[0][0]
     assert errs[1] == []
+
+
+def test_library_use_logs_its_first_compilation_once(caplog, monkeypatch):
+    """A ``numba:compile`` event of one of boundest's kernels (what Numba sends on a cache miss)
+    logs one WARNING on ``boundest.kernels``, once per process; a user's own function, none."""
+    import logging
+
+    import numba
+    from numba.core import event
+
+    from boundest import _kernels
+    from boundest.interval import rounding
+
+    for listener in getattr(_kernels, "_LIBRARY_NOTICE", []):
+        monkeypatch.setattr(listener, "said", False)  # as in a fresh process
+    monkeypatch.setattr(_kernels, "_CLI_ANNOUNCES", False, raising=False)
+    users = numba.njit(lambda v: v + 1.0)  # compiled only when called: never here
+
+    def compile_event(dispatcher):
+        with event.trigger_event("numba:compile", data={"dispatcher": dispatcher}):
+            pass
+
+    with caplog.at_level(logging.WARNING):
+        compile_event(users)
+        assert caplog.records == []
+        compile_event(rounding.next_up)
+        compile_event(rounding.next_down)
+    notes = [(r.name, r.levelno, r.getMessage()) for r in caplog.records]
+    assert len(notes) == 1, notes
+    name, level, text = notes[0]
+    assert (name, level) == ("boundest.kernels", logging.WARNING)
+    assert "compiling" in text and "next_up" in text and "setLevel(logging.ERROR)" in text
+
+
+NOTICE = """
+import logging, sys
+import numpy as np
+if sys.argv[1] == "quiet":
+    logging.getLogger("boundest").setLevel(logging.ERROR)
+from boundest.interval import rounding
+rounding.next_up(np.float32(1.0))  # a signature no cache holds: Numba compiles it
+rounding.next_down(np.float32(1.0))
+"""
+
+
+@pytest.mark.slow  # three subprocesses, each compiling two small kernels: about 15 s
+def test_a_first_compilation_in_library_use_is_said_once_on_stderr(tmp_path):
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), BOUNDEST_KERNEL_ARCHIVE="0")
+    errs = {}
+    for run, cache in (("quiet", "q"), ("first", "c"), ("cached", "c")):
+        env["NUMBA_CACHE_DIR"] = str(tmp_path / cache)
+        out = subprocess.run([sys.executable, "-c", NOTICE, run], env=env, capture_output=True,
+                             text=True, timeout=300)
+        assert out.returncode == 0, out.stderr[-2000:]
+        errs[run] = [line for line in out.stderr.splitlines() if "compiling" in line]
+    assert errs["quiet"] == [] and errs["cached"] == [], errs
+    assert len(errs["first"]) == 1 and "next_up" in errs["first"][0], errs
 
 
 CONSOLE = """

@@ -247,6 +247,21 @@ def test_model_declare_add_and_names():
         m.declare("d", Interval([0, 1], [1, 2]))
 
 
+def test_declaring_a_variable_again_intersects_its_domains():
+    m = Model()
+    v = m.declare("a", (0, 2))
+    assert m.declare(v, (1, 3)) is v
+    assert m.domains["a"] == Interval(1, 2)  # not (1, 3): a second statement, not a rewrite
+    m.declare("a")  # the entire line adds nothing
+    assert m.domains["a"] == Interval(1, 2)
+    m.declare("b", (0, 1))
+    m.declare("a", (1.5, 9))
+    assert m.domains["a"] == Interval(1.5, 2) and list(m.domains) == ["a", "b"]
+    with pytest.raises(ValueError, match=r"a declared in .*5.*after.*1\.5.*no solution"):
+        m.declare("a", (5, 6))
+    assert m.domains["a"] == Interval(1.5, 2)  # a refused declaration changes nothing
+
+
 # -------------------------------------------------------------------------------------------
 # 2. the model text format
 # -------------------------------------------------------------------------------------------

@@ -10,12 +10,10 @@ The names are loaded on first access (PEP 562), so that ``import boundest.cli`` 
 ``boundest --help`` load neither NumPy nor Numba. Importing boundest changes no process-wide
 state; the ``boundest`` command tunes glibc's allocator for its own process, and
 ``boundest.keep_freed_memory()`` does the same for a library user who asks (``_malloc``).
+
+``dir(boundest)`` lists the public names only: ``__all__``, the four builtin-shadowing functions
+above, the layers (``boundest.interval`` ... ``boundest.plot``) and the module's dunders.
 """
-
-from __future__ import annotations
-
-import importlib
-from typing import Any
 
 __version__ = "0.1.0"
 
@@ -40,26 +38,32 @@ _NAMES: dict[str, str] = {
     "keep_freed_memory": "_malloc",
 }
 _ALIASES = {"Box": "IntervalVector", "centered_form": "centered"}
-_SUBPACKAGES = ("interval", "expr", "ctc", "csp", "paving", "tube", "estimation", "scenarios",
-                "plot", "commands", "cli")
+#: the layers, documented in the API reference (listed by ``dir``), then the command line's
+_LAYERS = ("interval", "expr", "ctc", "csp", "paving", "tube", "estimation", "scenarios", "plot")
+_SUBPACKAGES = (*_LAYERS, "commands", "cli")
+#: public, but left out of ``__all__`` so that ``from boundest import *`` keeps the builtins
+_NOT_STARRED = ("abs", "min", "max", "pow")
 
 
 def _all() -> list[str]:
     from .expr import functions
     from .interval import __all__ as interval_all
 
-    named = [n for n in _NAMES if n not in ("abs", "min", "max", "pow")]
+    named = [n for n in _NAMES if n not in _NOT_STARRED]
     return list(dict.fromkeys([*interval_all, *functions.__all__, "__version__", *named]))
 
 
-def __getattr__(name: str) -> Any:
+def __getattr__(name: str) -> object:
+    from importlib import import_module
+
+    value: object
     if name == "__all__":
-        value: Any = _all()
+        value = _all()
     elif name in _NAMES:
-        module = importlib.import_module(f".{_NAMES[name]}", __name__)
+        module = import_module(f".{_NAMES[name]}", __name__)
         value = getattr(module, _ALIASES.get(name, name))
     elif name in _SUBPACKAGES:
-        value = importlib.import_module(f".{name}", __name__)
+        value = import_module(f".{name}", __name__)
     elif name.startswith("__"):
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
     else:
@@ -78,4 +82,7 @@ def __getattr__(name: str) -> Any:
 
 
 def __dir__() -> list[str]:
-    return sorted({*globals(), *_all(), "abs", "min", "max", "pow"})
+    """The public names: no helper, private table or command-line module (``__all__``, the
+    builtin-shadowing functions, the layers and the dunders)."""
+    dunders = [n for n in globals() if n.startswith("__") and n.endswith("__")]
+    return sorted({*dunders, *_all(), *_NOT_STARRED, *_LAYERS})

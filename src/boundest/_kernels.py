@@ -15,6 +15,12 @@ CPU name and features) accepts the entries. When anything does not match, or the
 read-only, it does nothing and kernels compile as before. ``BOUNDEST_KERNEL_ARCHIVE=0``
 disables it.
 
+A kernel that neither the cache nor the archive holds compiles on first use, seconds of
+silence: the command line announces it on standard error (:func:`announce_compilation`), library
+use once per process through ``logging`` (:func:`notice_compilation`, a WARNING of the
+``boundest.kernels`` logger; ``logging.getLogger("boundest").setLevel(logging.ERROR)`` silences
+it).
+
 ``python -m boundest._kernels check`` says in one line whether the archive matches the
 sources. Building and verifying it runs every command, so it lives in a module that the
 package never imports, :mod:`boundest._kernels_build` (``python -m boundest._kernels_build
@@ -35,6 +41,7 @@ from __future__ import annotations
 import hashlib
 import io
 import json
+import logging
 import os
 import pickle
 import platform
@@ -252,13 +259,15 @@ def activate() -> str:
     """Unpack the archive if it fits and the cache lacks the package's kernels; make this
     process use the archive's target if the archive is (or was) unpacked in this cache.
 
-    Returns (and records in ``STATUS``) what it did. Never raises.
+    Returns (and records in ``STATUS``) what it did. Never raises. Also registers the notice
+    of a first compilation in library use (:func:`notice_compilation`).
     """
     global STATUS
     try:
         STATUS = _activate()
     except Exception as exc:  # any failure: plain compilation, as before
         STATUS = f"not used ({type(exc).__name__}: {exc})"
+    notice_compilation()
     return STATUS
 
 
@@ -292,6 +301,62 @@ def _activate() -> str:
     return "installed"
 
 
+#: The logger of the compilation notice of library use (a child of ``boundest``'s logger).
+LOG = logging.getLogger("boundest.kernels")
+#: Whether this process's compilation notice is the command line's (then the library's is off).
+_CLI_ANNOUNCES = False
+_LIBRARY_NOTICE: list = []  # the library's listener once registered (once per process)
+
+
+class _LibraryNotice:
+    """The listener behind :func:`notice_compilation` (a Numba ``event.Listener``)."""
+
+    def __init__(self) -> None:
+        self.said = False
+
+    def on_start(self, ev: object) -> None:
+        if self.said or _CLI_ANNOUNCES:
+            return
+        func = getattr(getattr(ev, "data", {}).get("dispatcher"), "py_func", None)
+        module = getattr(func, "__module__", "") or ""
+        if not module.startswith("boundest."):
+            return  # the user's own Numba functions are theirs to announce
+        self.said = True
+        what = ("Numba kernels that the shipped kernel archive lacks"
+                if STATUS in ("installed", "in use") else "its Numba kernels")
+        LOG.warning("boundest: compiling %s (first %s; a few seconds per family of kernels, "
+                    "once: they are cached on disk for later runs) ... [silence: logging."
+                    "getLogger('boundest').setLevel(logging.ERROR)]", what, func.__qualname__)
+
+    def on_end(self, ev: object) -> None:
+        pass
+
+
+def notice_compilation() -> None:
+    """Log once per process, on the ``boundest.kernels`` logger at WARNING level, that Numba
+    compiles one of boundest's kernels (a cache miss: seconds of silence otherwise).
+
+    WARNING, because Python shows a warning on standard error when the application configured
+    no logging (``logging.lastResort``) and shows nothing below it: the library configures no
+    handler, and an application that configures logging routes the notice with the rest.
+    ``logging.getLogger("boundest").setLevel(logging.ERROR)`` silences it. Kernels found in the
+    on-disk cache (or the shipped archive) compile nothing and say nothing; the command line
+    announces its own compilation instead (:func:`announce_compilation`). Called by
+    :func:`activate` (at import of ``boundest.interval``); registering again does nothing.
+    Never raises.
+    """
+    if _LIBRARY_NOTICE:
+        return
+    try:
+        from numba.core import event
+
+        listener = type("_Notice", (_LibraryNotice, event.Listener), {})()
+        event.register("numba:compile", listener)
+        _LIBRARY_NOTICE.append(listener)
+    except Exception:  # a Numba without events: kernels compile without the notice
+        pass
+
+
 def announce_compilation(what: str, estimate_s: float | None = None) -> None:
     """Print one line on standard error when Numba first compiles a kernel in this process.
 
@@ -302,6 +367,9 @@ def announce_compilation(what: str, estimate_s: float | None = None) -> None:
     ``estimate_s`` is its measured empty-cache compile time on 2 cores (printed as "about N s").
     """
     from numba.core import event
+
+    global _CLI_ANNOUNCES
+    _CLI_ANNOUNCES = True  # one notice per process: the command line's, naming the command
 
     class _Notice(event.Listener):
         def __init__(self) -> None:

@@ -16,7 +16,7 @@ import numpy as np
 
 from ..ctc.linear import CtcLinear, contract_slots
 from ..expr.model import Model
-from ..expr.nodes import Constraint
+from ..expr.nodes import Constraint, Var, VarFamily
 from ..expr.tape import Tape, compile_model
 from ..interval import Interval
 from .propagate import Propagation, propagate
@@ -62,8 +62,13 @@ class LPPropagation:
     def time_s(self) -> float:
         return self.lp_time_s + self.hc_time_s
 
-    def __getitem__(self, name: str) -> Interval:
-        return self.propagation.domains[name]
+    def __getitem__(self, key: str | Var | VarFamily) -> Interval:
+        """The final domain of a variable or family (``Propagation.__getitem__``)."""
+        return self.propagation[key]
+
+    def bounds(self, key: str | Var | VarFamily) -> tuple[np.ndarray, np.ndarray]:
+        """Lower and upper bounds as arrays (``Propagation.bounds``)."""
+        return self.propagation.bounds(key)
 
 
 def propagate_lp(model: Model | list[Constraint] | Tape, *, targets: list[str] | None = None,

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..expr.model import Model
-from ..expr.nodes import Constraint
+from ..expr.nodes import Constraint, Var, VarFamily
 from ..expr.tape import Tape, compile_model
 from ..interval import Interval
 from .engine import (
@@ -29,7 +29,7 @@ from .engine import (
 )
 
 __all__ = ["DEFAULT_MODE", "MODES", "BoxConsistency", "Centered", "LinearRelaxation", "Propagation",
-           "Shaving", "arg_users", "bc_candidates", "propagate", "slot_users"]
+           "Shaving", "arg_users", "bc_candidates", "domain_of", "propagate", "slot_users"]
 
 #: The propagation modes: hull consistency alone, then box consistency, 3B shaving, box
 #: consistency and shaving, LP contraction, the centered form of windows of constraints, or
@@ -206,10 +206,14 @@ class Centered:
 class Propagation:
     """Result of ``propagate``.
 
+    ``res[v]`` is the final domain of a variable ``v`` (a name or the ``Var`` itself), ``res[x]``
+    that of a whole ``VarFamily`` as an interval array, and ``res.bounds(x)`` its lower and
+    upper bounds as NumPy arrays in one call.
+
     Attributes
     ----------
     domains : dict of str -> Interval
-        Final domain of every variable (empty intervals when inconsistent).
+        Final domain of every variable, by name (empty intervals when inconsistent).
     consistent : bool
         False when the CSP was *proven* to have no solution.
     evaluations : int
@@ -257,8 +261,32 @@ class Propagation:
     linear: dict = field(default_factory=dict)
     centered: dict = field(default_factory=dict)
 
-    def __getitem__(self, name: str) -> Interval:
-        return self.domains[name]
+    def __getitem__(self, key: str | Var | VarFamily) -> Interval:
+        """The final domain of a variable, by name or by the ``Var`` itself (``res["x_3"]``,
+        ``res[x[3]]``); of a whole ``VarFamily``, an interval array (``res[x]``, see
+        :meth:`bounds`)."""
+        return domain_of(self.domains, key)
+
+    def bounds(self, key: str | Var | VarFamily) -> tuple[np.ndarray, np.ndarray]:
+        """Lower and upper bounds of a variable or of a whole family, as NumPy arrays.
+
+        For a ``VarFamily`` ``x`` indexed ``x[k]``, both arrays have shape ``(K,)``, ``K - 1``
+        the largest ``k`` in the model; indexed ``x[k, i]``, shape ``(K, I)``; entry ``[k, i]``
+        is the domain of ``x[k, i]`` (NaN, NaN for an empty domain). Every index up to the
+        largest must be a variable of the model, or ``KeyError`` names those missing. For one
+        variable, 0-d arrays.
+
+        >>> from boundest.expr import Model, VarFamily
+        >>> x = VarFamily("x")
+        >>> m = Model()
+        >>> _ = m.declare(x[0], (0, 1))
+        >>> res = propagate(m.add(x[1] == x[0] + 1, x[2] == 2 * x[1]), mode="hc4")
+        >>> lo, hi = res.bounds(x)
+        >>> lo, hi
+        (array([0., 1., 2.]), array([1., 2., 4.]))
+        """
+        dom = domain_of(self.domains, key)
+        return np.array(dom.lo, dtype=float), np.array(dom.hi, dtype=float)
 
     def __repr__(self) -> str:
         """Counts and summary numbers, never every domain (``domains`` holds them)."""
@@ -269,6 +297,29 @@ class Propagation:
                 f"empty={empty}, unbounded={unbounded}, evaluations={self.evaluations}, "
                 f"iterations={self.iterations:.3g}, time_s={self.time_s:.3g}, "
                 f"n_nodes={self.n_nodes}, n_slots={self.n_slots}, mode={self.mode!r})")
+
+
+def domain_of(domains: dict[str, Interval], key: str | Var | VarFamily) -> Interval:
+    """``domains[key]`` for a name or a ``Var``; for a ``VarFamily``, the interval array of its
+    members (``Propagation.bounds`` details the shape; ``KeyError`` names missing members)."""
+    if isinstance(key, VarFamily):
+        members = key.members(domains)
+        if not members:
+            raise KeyError(f"no variable of the family {key.name!r} ({key.name}_0 ...)")
+        shape = tuple(max(k[j] for k in members) + 1 for j in range(len(next(iter(members)))))
+        missing = [f"{key.name}_" + "_".join(map(str, k)) for k in np.ndindex(*shape)
+                   if k not in members]
+        if missing:
+            raise KeyError(f"family {key.name!r} has {len(missing)} gaps below its largest "
+                           f"index: {', '.join(missing[:5])}{' ...' if len(missing) > 5 else ''}")
+        lo, hi = np.empty(shape), np.empty(shape)
+        for k, name in members.items():
+            lo[k], hi[k] = float(domains[name].lo), float(domains[name].hi)
+        return Interval.trusted(lo, hi)
+    name = key.name if isinstance(key, Var) else key
+    if not isinstance(name, str):
+        raise TypeError(f"a variable is named by a str, a Var or a VarFamily, not {key!r}")
+    return domains[name]
 
 
 def slot_users(tape: Tape) -> tuple[np.ndarray, np.ndarray]:
@@ -317,10 +368,12 @@ def bc_candidates(tape: Tape, slots: np.ndarray, max_nodes: int
 
 
 def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
-              max_evaluations: int | None = None, domains: dict[str, Interval] | None = None,
+              max_evaluations: int | None = None,
+              domains: dict[str | Var, Interval] | None = None,
               progress: bool | None = None, chunk: int = 2_000_000, window: int = 64,
-              mode: str | None = None, shave: list[str] | None = None,
-              shaving: Shaving | None = None, targets: list[str] | None = None,
+              mode: str | None = None, shave: list[str | Var | VarFamily] | None = None,
+              shaving: Shaving | None = None,
+              targets: list[str | Var | VarFamily] | None = None,
               boxcons: BoxConsistency | None = None,
               linear: LinearRelaxation | None = None,
               centered: Centered | None = None) -> Propagation:
@@ -378,7 +431,7 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
     max_evaluations : int, optional
         Budget of node revisions (default: 10,000 per node).
     domains : dict, optional
-        Domains overriding the model's initial ones (by variable name).
+        Domains narrowing the model's initial ones (keyed by variable name or ``Var``).
     progress : bool, optional
         Show a progress counter of node revisions and dirty nodes (default: only when the run
         lasts more than 2 s).
@@ -393,12 +446,13 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
         centered form, or shaving and the centered form. Default :data:`DEFAULT_MODE`
         (``"3b+centered"``), or ``"3b"`` for a ``Tape`` built without its model (by
         ``expr.tape.instantiate``), which cannot be differentiated.
-    shave : list of str, optional
+    shave : list of str, Var or VarFamily, optional
         With ``mode="3b"``: the variables to shave, in the order they are visited (for a time
-        series, by time step; default: every variable of the model in its order).
+        series, by time step; default: every variable of the model in its order). A
+        ``VarFamily`` stands for its members, in index order; so in ``targets``.
     shaving : Shaving, optional
         With ``mode="3b"``: the shaving settings (default ``Shaving()``).
-    targets : list of str, optional
+    targets : list of str, Var or VarFamily, optional
         With ``mode="bc"`` or ``"bc+3b"``: the variables box consistency narrows (those among
         them that occur several times; default: every variable); with ``mode="lp"``: the
         variables the LPs contract (default: every variable; each costs two LPs, four where it
@@ -419,6 +473,7 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
     if window < 1:
         raise ValueError(f"window must be a positive number of nodes, got {window}")
     tape = model if isinstance(model, Tape) else compile_model(model)
+    shave, targets = _names(tape, shave), _names(tape, targets)
     if mode is None:
         mode = DEFAULT_MODE if tape.model is not None else "3b"
     if mode in ("centered", "3b+centered") and tape.model is None:
@@ -429,7 +484,8 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
 
         _linprog()  # fails before any work, naming the extra, when SciPy is missing
     lo, hi = tape.lo.copy(), tape.hi.copy()
-    for name, dom in (domains or {}).items():
+    for key, dom in (domains or {}).items():
+        name = key.name if isinstance(key, Var) else key
         if name not in tape.slot_of:
             raise ValueError(f"unknown variable {name!r}")
         s = tape.slot_of[name]
@@ -632,6 +688,21 @@ def _centered_rounds(tape: Tape, lo: np.ndarray, hi: np.ndarray, ptr: np.ndarray
                          "min_gain": opts.min_gain},
             "time_s": time.perf_counter() - t0}
     return status, info
+
+
+def _names(tape: Tape, keys: list[str | Var | VarFamily] | None) -> list[str] | None:
+    """The variable names of ``keys``: a ``Var`` by its name, a ``VarFamily`` by its members in
+    the model, in index order."""
+    if keys is None:
+        return None
+    names: list[str] = []
+    for key in keys:
+        if isinstance(key, VarFamily):
+            members = key.members(tape.slot_of)
+            names += [members[k] for k in sorted(members)]
+        else:
+            names.append(key.name if isinstance(key, Var) else key)
+    return names
 
 
 def _shave_slots(tape: Tape, names: list[str] | None, arg: str = "shave") -> np.ndarray:

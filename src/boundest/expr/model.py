@@ -15,7 +15,8 @@ __all__ = ["Model"]
 class Model:
     """Variables (name -> scalar interval domain) and constraints over them.
 
-    Variables used by a constraint but not declared get the entire line as domain.
+    Variables used by a constraint but not declared get the entire line as domain; a variable
+    declared twice gets the intersection of its domains (``declare``).
     ``options`` keeps header lines of a model file (e.g. RealPaver's ``Bisection none;``),
     ``option_lines`` the line of each in the file.
     """
@@ -27,12 +28,26 @@ class Model:
 
     def declare(self, var: Var | str, domain: Interval | tuple[float, float] | None = None
                 ) -> Var:
-        """Declare a variable with a domain (entire line by default); returns the ``Var``."""
+        """Declare a variable with a domain (entire line by default); returns the ``Var``.
+
+        Declaring a variable again intersects its domains: each declaration is one more
+        statement that the variable lies in its domain, as a bound from a second sensor
+        would be (``declare(x)`` alone adds nothing). An empty intersection is refused with a
+        ``ValueError`` naming both domains, the model being left as it was: the model would
+        have no solution. To replace a domain, assign ``model.domains[name]``.
+        """
         v = var if isinstance(var, Var) else Var(var)
         dom = Interval.entire() if domain is None else (
             domain if isinstance(domain, Interval) else Interval(*domain))
         if dom.shape != ():
             raise ValueError(f"domain of {v.name} must be a scalar interval, got {dom}")
+        old = self.domains.get(v.name)
+        if old is not None:
+            both = old & dom
+            if bool(both.is_empty()) and not (bool(old.is_empty()) or bool(dom.is_empty())):
+                raise ValueError(f"{v.name} declared in {dom} after {old}: the domains do not "
+                                 "meet, so the model would have no solution")
+            dom = both
         self.domains[v.name] = dom
         return v
 

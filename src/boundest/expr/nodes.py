@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import math
 import numbers
+import re
 from collections.abc import Iterable
 
 from ..interval import Interval, as_interval
@@ -197,6 +198,27 @@ class VarFamily:
             var = Var(self.name + "".join(f"_{int(i)}" for i in key))
             self._members[key] = var
         return var
+
+    def members(self, names: Iterable[str]) -> dict[tuple[int, ...], str]:
+        """The members of this family among ``names``, by index: ``{(k,): "x_k"}`` or
+        ``{(k, i): "x_k_i"}``, whether or not they were built by indexing this object (a model
+        parsed from text names its variables ``x_k`` too).
+
+        Raises ``ValueError`` when the members found have different numbers of indices (``x_1``
+        and ``x_1_0``, which may be another family ``x_1``): ask for that family by its own name.
+        """
+        pattern = re.compile(re.escape(self.name) + r"((?:_(?:0|[1-9][0-9]*))+)")
+        found: dict[tuple[int, ...], str] = {}
+        for n in names:
+            m = pattern.fullmatch(n)
+            if m:
+                found[tuple(int(i) for i in m.group(1)[1:].split("_"))] = n
+        arity = {len(k) for k in found}
+        if len(arity) > 1:
+            raise ValueError(f"family {self.name!r}: members with {sorted(arity)} indices "
+                             f"({', '.join(sorted(found.values())[:4])} ...); name the family "
+                             "of the longer names (e.g. VarFamily('x_1') for x_1_0) instead")
+        return found
 
     def __repr__(self) -> str:
         return f"VarFamily({self.name!r})"
