@@ -330,3 +330,101 @@ def test_range_and_bearing_from_a_landmark():
     ctc = CtcPolar(center=(3.0, 4.0))
     out = ctc(Interval([-10, -10, 4.999, bearing - 1e-9], [10, 10, 5.001, bearing + 1e-9]))
     assert np.allclose(out.lo[:2], 0.0, atol=2e-3) and np.allclose(out.hi[:2], 0.0, atol=2e-3)
+
+
+# -------------------------------------------------------------------------------------------
+# theta at the float nearest a multiple of pi/2 (issue 27, item 10)
+# -------------------------------------------------------------------------------------------
+
+def _ulps_beyond(ours: Interval, theirs: Interval) -> np.ndarray:
+    """Per box, how many ulps (of ``theirs``' bound) ``ours`` sticks out of ``theirs``."""
+    def ulps(a, b):
+        return np.abs(a - b) / np.maximum(np.spacing(np.abs(b)), 5e-324)
+    lo = np.where(ours.lo < theirs.lo, ulps(ours.lo, theirs.lo), 0.0)
+    hi = np.where(ours.hi > theirs.hi, ulps(ours.hi, theirs.hi), 0.0)
+    return np.maximum(lo, hi).max(axis=-1)
+
+
+def test_theta_next_to_a_quarter_turn_bounds_rho():
+    """theta is the float t nearest -5 pi/2: cos t = 3.06e-16 (exactly, up to mpmath), not
+    0, so x = rho cos t with x in [1e-17, 2e-17] puts rho in [1e-17, 2e-17] / cos t
+    = [0.0327, 0.0653] and y = rho sin t in -rho (1 - 5e-32). The angle of t past -5 pi/2
+    (3e-16) is below one ulp of t (9e-16): the bounds from cos and sin of t itself must win
+    over the float bound of that angle."""
+    t = -5 * math.pi / 2
+    box = Interval([1e-17, -1, 0, t], [2e-17, 1, 1, t])
+    out = CTC(box)
+    with mpmath.workdps(60):
+        c, s = mpmath.cos(mpmath.mpf(t)), mpmath.sin(mpmath.mpf(t))
+        r_lo, r_hi = mpmath.mpf(1e-17) / c, mpmath.mpf(2e-17) / c
+        expect = [(1e-17, 2e-17), (r_hi * s, r_lo * s), (r_lo, r_hi), (t, t)]
+    for k, (a, b) in enumerate(expect):
+        assert out.lo[k] <= a and b <= out.hi[k], k  # sound
+        # and tight, up to the roundings (the enclosure of libm's cos t, of rho's bound,
+        # then of the product: 12 ulps for y's upper bound, the same as forward-backward)
+        assert float(a) - out.lo[k] <= 16 * np.spacing(abs(float(a)))
+        assert out.hi[k] - float(b) <= 16 * np.spacing(abs(float(b)))
+    assert out.is_subset(_inflated(HC4(box), 1e-15)).all()
+
+
+def _quarter_turn_boxes(rng: np.random.Generator, n: int):
+    """``(lo, hi, points)``: ``n`` boxes, half of them around a solution whose theta is a
+    float nearest (or next to) a multiple of pi/2, with one of x, y a few 1e-16 rho; the
+    others random boxes whose theta ends are such floats. ``points`` lists, per box, exact
+    solutions ``(x, y, rho, theta)`` in it (x, y as mpf)."""
+    lo, hi, points = np.empty((n, 4)), np.empty((n, 4)), []
+    for i in range(n):
+        t = rng.integers(-12, 13) * (math.pi / 2)
+        t = float(np.nextafter(t, rng.choice([-INF, INF]))) if rng.random() < 0.3 else t
+        if i % 2 == 0:  # around a solution (rho, t); widths zero, tiny or wide
+            rho = float(rng.uniform(0.01, 3.0))
+            x, y = exact_xy(rho, t)
+            p = []
+            for k, v in enumerate((x, y, mpmath.mpf(rho), mpmath.mpf(t))):
+                w = [0.0, 0.0] if k == 3 and rng.random() < 0.6 else [
+                    rng.choice([0.0, 1e-17 * rng.random(), 1e-15 * rng.random(), rng.random()])
+                    for _ in range(2)]
+                with mpmath.workdps(DPS):  # x = rho cos(5e-324) is below rho by 1e-647 rho
+                    p.append((down(v - w[0]), up(v + w[1])))
+            lo[i], hi[i] = [a for a, _ in p], [b for _, b in p]
+            pts = [(x, y, rho, t)]
+        else:  # a random box with a tiny x or y range
+            for k in range(3):
+                a = rng.uniform(-3.0, 3.0)
+                lo[i, k], hi[i, k] = a, a + rng.uniform(0.0, 3.0)
+            k = rng.integers(0, 2)
+            lo[i, k] = rng.choice([1e-17, -1e-17, 3e-16, -3e-16, 1e-300])
+            hi[i, k] = lo[i, k] + abs(lo[i, k]) * rng.uniform(0.0, 2.0)
+            lo[i, 2] = abs(lo[i, 2])
+            hi[i, 2] = max(hi[i, 2], lo[i, 2])
+            w = 0.0 if rng.random() < 0.6 else rng.uniform(0.0, 2.0)
+            lo[i, 3], hi[i, 3] = (t, t + w) if rng.random() < 0.5 else (t - w, t)
+            pts = []
+        # more solutions: (rho, theta) drawn in the box, kept when (x, y) is in it
+        for _ in range(20):
+            r = float(rng.uniform(max(lo[i, 2], 0.0), hi[i, 2]))
+            s = float(rng.uniform(lo[i, 3], hi[i, 3]))
+            for r_, s_ in ((r, s), (r, lo[i, 3]), (r, hi[i, 3])):
+                px, py = exact_xy(r_, s_)
+                if holds(Interval(lo[i], hi[i]), px, py, r_, s_):
+                    pts.append((px, py, r_, s_))
+        points.append(pts)
+    return lo, hi, points
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_quarter_turns_as_tight_as_hull_consistency_and_sound(seed):
+    """Boxes whose theta is (or ends at) a float nearest k pi/2: the result is inside the
+    fixpoint of forward-backward propagation up to 16 ulps (libm's and the rounding's
+    errors), empty where that one is, and keeps every sampled solution (exact x, y)."""
+    lo, hi, points = _quarter_turn_boxes(np.random.default_rng(seed), 400)
+    box = Interval(lo, hi)
+    ours, theirs = CTC(box), HC4(box)
+    ours_empty, theirs_empty = ours.is_empty().any(-1), theirs.is_empty().any(-1)
+    assert not (theirs_empty & ~ours_empty).any()
+    both = ~ours_empty & ~theirs_empty
+    beyond = _ulps_beyond(ours, theirs)
+    assert (beyond[both] <= 16).all(), np.flatnonzero(both & (beyond > 16))
+    for i, pts in enumerate(points):
+        for p in pts:
+            assert holds(ours[i], *p), (i, p)

@@ -17,6 +17,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+import boundest as bd
 from boundest import Interval, Var
 from boundest.tube import ContractorNetwork, CtcDeriv, CtcEval, CtcSlices, Tube
 from boundest.tube.eval import invert_kernel
@@ -223,6 +224,73 @@ def test_eval_codac_unit_case_2():
     z = Fraction(1.6)  # the float: the exact bounds are 2 + (z - 1) and 3 + (2 - z)
     assert Fraction(float(T.lo)) <= 1 + z and 5 - z <= Fraction(float(T.hi))
     assert float(Z.lo) == 1.6 == float(Z.hi)
+
+
+def _sin_pair_tubes() -> tuple[Tube, Tube]:
+    """Codac's "CtcEval, dependency on t" (tests_ctc_eval.cpp): x = (sin t, -sin t) on
+    [0, 10], slices of 0.1 (outward enclosures), and here its derivative (cos t, -cos t)."""
+    def pair(f):
+        def g(T: Interval) -> Interval:
+            v = f(T)
+            return Interval.trusted(np.stack([v.lo, -v.hi], -1), np.stack([v.hi, -v.lo], -1))
+        return g
+    return (Tube.from_function(0, 10, 0.1, pair(bd.sin)),
+            Tube.from_function(0, 10, 0.1, pair(bd.cos)))
+
+
+def test_eval_codac_dependency_on_t():
+    """x(t) in [0, 2]^2 for some t in [0, 10]: sin t >= 0 and -sin t >= 0 at the same t, so
+    sin t = 0, t in {0, pi, 2 pi, 3 pi}, z = (0, 0): these must stay. Per component the
+    times are [0, pi] u [2 pi, 3 pi] and {0} u [pi, 2 pi] u [3 pi, 10], whose hulls share
+    [0, 3 pi], where each component reaches 1: the hull per component gives [0, 1]^2.
+    With the derivative the common times are near k pi only: on the slice [a, a + h] holding
+    k pi (h = 0.1; k = 0 is the gate t = 0, where both are 0), both components leave the gate
+    at a as +-u (u = sin a, |u| <= k pi - a) with slopes of opposite signs and magnitudes in
+    [m, M], m >= cos h, M <= 1. Both are >= 0 at a + s only if s is in [|u| / M, |u| / m];
+    there each is at most |u| (M / m - 1) <= h (1 / cos h - 1) = 5.0e-4, and
+    a + |u| / m <= k pi + (k pi - a)(1 / m - 1) <= k pi + 5.0e-4. (Codac gives
+    t = [0, 9.5] and z within 0.02 of 0, without the derivative.)"""
+    x, w = _sin_pair_tubes()
+    bound = 0.1 * (1 / math.cos(0.1) - 1) * (1 + 1e-6)
+    T, Z = CtcEval().contract(Interval(0, 10), Interval([0, 0], [2, 2]), x.copy(), w)
+    assert float(T.lo) == 0.0 and 3 * math.pi <= float(T.hi) <= 3 * math.pi + bound
+    assert (Z.lo == 0).all() and (Z.hi <= bound).all()
+
+
+def test_eval_codac_dependency_on_t_plain():
+    """The same case on whole slices (no derivative): slice [a, a + h] is kept when both
+    envelopes meet [0, 2], i.e. when it holds k pi: [0, 0.1], [3.1, 3.2], [6.2, 6.3],
+    [9.4, 9.5]. So t = [0, 9.5], z_1 = [0, max sin over them] = [0, sin 0.1] (sin is largest
+    at the end of [0, 0.1]), z_2 = [0, max -sin over them] = [0, -sin 6.2] (the slices give
+    0, -sin 3.2, -sin 6.2, -sin 9.5). Codac intersects z with each piece's image instead of
+    taking their hull, which loses trajectories of the tube (x = (0.09, 0) at t = 0.05)."""
+    x, w = _sin_pair_tubes()
+    T, Z = CtcEval(time_deriv=False).contract(Interval(0, 10), Interval([0, 0], [2, 2]),
+                                              x.copy(), w)
+    assert (float(T.lo), float(T.hi)) == (0.0, 9.5)
+    assert (Z.lo == 0).all()
+    assert Z.hi[0] == pytest.approx(math.sin(0.1), rel=1e-14) and Z.hi[0] >= math.sin(0.1)
+    assert Z.hi[1] == pytest.approx(-math.sin(6.2), rel=1e-14) and Z.hi[1] >= -math.sin(6.2)
+
+
+@settings(max_examples=40)
+@given(trajectories(), trajectories(), grids(), seeds, st.floats(0, 1), st.floats(0, 1),
+       st.floats(0, 1), st.sampled_from([0.0, 1e-3, 0.1, 1.0]), st.booleans())
+def test_eval_vector_keeps_truth(tr1, tr2, t, seed, where, left, right, zrad, time_deriv):
+    # two components measured at the same uncertain time: the time pieces common to both
+    # components, slice by slice, keep the true time, values and trajectories
+    rng = np.random.default_rng(seed)
+    y = Tube.stack([tube_around(tr1, t, rng), tube_around(tr2, t, rng)])
+    w = Tube.stack([tube_around(tr1, t, rng, deriv=True), tube_around(tr2, t, rng, deriv=True)])
+    ts = float(t[0] + where * (t[-1] - t[0]))
+    tm = Interval(ts - left * (ts - t[0]), ts + right * (t[-1] - ts))
+    v1, v2 = tr1.value(ts), tr2.value(ts)
+    z = Interval([float(v1) - zrad - 1e-9, float(v2) - zrad - 1e-9],
+                 [float(v1) + zrad + 1e-9, float(v2) + zrad + 1e-9])
+    tm, z = CtcEval(time_deriv).contract(tm, z, y, w)
+    assert inside(tm, mpmath.mpf(ts)) and inside(z[0], v1) and inside(z[1], v2)
+    times = sample_times(t, rng)
+    assert tube_keeps(y[0], tr1, times) and tube_keeps(y[1], tr2, times)
 
 
 @settings(max_examples=60)

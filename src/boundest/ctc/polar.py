@@ -31,8 +31,12 @@ angle ``atan2(c, a)``, where it is ``|(a, c)|``, and increases away from it, so 
 the three is its least value on the interval; likewise for the far corner). Every function is
 evaluated at its float bounds with the outward-rounded kernels of :mod:`boundest.interval`,
 and ``psi_lo``, ``psi_hi`` are rounded outward, so the monotonicity keeps every bound sound.
-Where ``psi_lo`` or ``psi_hi`` is a bound of ``theta`` itself, cos and sin are those of that
-float ``theta`` (``cos psi = sin theta`` etc.), and near a multiple of ``pi/2`` the sign of
+At an end of ``theta`` inside the piece, cos and sin of the end are those of that float
+``theta`` (``cos psi = sin theta`` etc.), and they bound those of ``psi_lo`` (``psi_hi``) as well
+as the term's float bound does: the tighter of the two is taken, since the float bound of the
+end's angle can be far from it (one ulp of ``theta``, 9e-16 near ``5 pi/2``, where the angle
+may be 3e-16, so a term above that float bound may still lie below the end's angle).
+Near a multiple of ``pi/2`` the sign of
 ``sin(theta - j pi/2)`` tells which piece it starts: ``theta = 2*math.pi``, a float just below
 ``2 pi``, stays exact.
 
@@ -205,8 +209,16 @@ def _quarter(q, alpha, ca_u, sa_d, beta, cb_d, sb_u, xl, xh, yl, yh, r1, r2):
         phi = min(phi, _acos_enc(div_dn(a, r2))[1], _atan2_up_w(d, a))
     if not plo <= phi:
         return False, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN
-    cl_u, sl_d = (ca_u, sa_d) if plo == alpha else (_cos_w(plo)[1], _sin_w(plo)[0])
-    ch_d, sh_u = (cb_d, sb_u) if phi == beta else (_cos_w(phi)[0], _sin_w(phi)[1])
+    # cos, sin at psi_lo: both the end's (exact theta) and the term's (float plo <= the
+    # term) bound them, psi_lo being the larger of the two; take the tighter of each. The
+    # float alpha can be far below the end's angle (one ulp of theta, 9e-16 near 5 pi/2,
+    # where the angle itself may be 3e-16), so plo > alpha does not mean the term wins.
+    cl_u, sl_d = ca_u, sa_d
+    if plo > alpha:
+        cl_u, sl_d = min(cl_u, _cos_w(plo)[1]), max(sl_d, _sin_w(plo)[0])
+    ch_d, sh_u = cb_d, sb_u
+    if phi < beta:
+        ch_d, sh_u = max(ch_d, _cos_w(phi)[0]), min(sh_u, _sin_w(phi)[1])
     # x' bounds
     xlo = max(a, mul_dn(r1, ch_d))
     if c > 0.0:

@@ -44,7 +44,7 @@ from ..interval.rounding import (
 from .deriv import _lin_dn, _lin_up, slice_hi
 from .tube import Tube
 
-__all__ = ["CtcEval", "eval_kernel", "invert_kernel"]
+__all__ = ["CtcEval", "eval_kernel", "invert_kernel", "invert_pieces", "values_over_pieces"]
 
 _njit = nb.njit(cache=True, error_model="numpy")
 
@@ -106,42 +106,45 @@ def _slice_times(t0: float, t1: float, g0lo: float, g0hi: float, g1lo: float, g1
 
 
 @_njit
-def invert_kernel(t: NDArray, slo: NDArray, shi: NDArray, glo: NDArray, ghi: NDArray,
-                  wlo: NDArray, whi: NDArray, tlo: float, thi: float, zlo: float, zhi: float
-                  ) -> tuple[float, float, float, float]:
-    """``[t] ∩ [y]^{-1}([z])`` with the derivative: the hull of the times in ``[tlo, thi]``
-    (inside the domain, ``tlo <= thi``) at which a trajectory of the scalar tube with
-    ``y' ∈ [w]`` may lie in ``[z]`` (on each slice, the polygon of the two cones from its gates
-    inside its envelope, projected exactly; Rohou et al. 2018 use the same polygon), and the
-    hull of the values in ``[z]`` such trajectories take over the contracted times (the polygon
-    between virtual gates at the new bounds of ``[t]``). Returns ``(t_lo, t_hi, z_lo, z_hi)``,
-    ``t_lo > t_hi`` when no trajectory meets ``[z]`` in ``[t]``."""
+def invert_pieces(t: NDArray, slo: NDArray, shi: NDArray, glo: NDArray, ghi: NDArray,
+                  wlo: NDArray, whi: NDArray, tlo: float, thi: float, zlo: float, zhi: float,
+                  plo: NDArray, phi: NDArray) -> None:
+    """Intersect, slice by slice, the time pieces ``[plo[i], phi[i]]`` (``plo > phi``: none)
+    with the times in ``[tlo, thi]`` (inside the domain, ``tlo <= thi``) at which a trajectory
+    of the scalar tube with ``y' ∈ [w]`` may lie in ``[z]`` (on each slice, the polygon of the
+    two cones from its gates inside its envelope, projected exactly; Rohou et al. 2018 use the
+    same polygon), in place. Start from ``(-INF, INF)`` everywhere and call it once per
+    component: the pieces are then the times at which every component may meet its ``[z]``
+    at the same time, slice by slice (a hull per component would lose that dependency)."""
     n = slo.size
     i0 = min(max(np.searchsorted(t, tlo, side="right") - 1, 0), n - 1)
     i1 = min(max(np.searchsorted(t, thi, side="left"), i0 + 1), n)
-    rlo, rhi = INF, -INF
-    for i in range(i0, i1):
-        p, q = max(t[i], tlo), min(t[i + 1], thi)
-        if p > q:
+    for i in range(n):
+        if not (i0 <= i < i1 and plo[i] <= phi[i]):
+            plo[i], phi[i] = INF, -INF
             continue
+        p, q = max(t[i], tlo, plo[i]), min(t[i + 1], thi, phi[i])
         x, y = max(slo[i], zlo), min(shi[i], zhi)
-        if not x <= y:
-            continue
-        a, b = _slice_times(t[i], t[i + 1], glo[i], ghi[i], glo[i + 1], ghi[i + 1], wlo[i],
-                            whi[i], x, y)
-        a, b = max(a, p), min(b, q)
-        if a <= b:
-            rlo, rhi = min(rlo, a), max(rhi, b)
-    if not rlo <= rhi:
-        return INF, -INF, INF, -INF
-    # the values over the contracted times: each slice part [a, b] is bounded by the polygon
-    # between virtual gates at a and b (the cone bounds there, inside the envelope)
+        a, b = INF, -INF
+        if p <= q and x <= y:
+            a, b = _slice_times(t[i], t[i + 1], glo[i], ghi[i], glo[i + 1], ghi[i + 1], wlo[i],
+                                whi[i], x, y)
+            a, b = max(a, p), min(b, q)
+        plo[i], phi[i] = (a, b) if a <= b else (INF, -INF)
+
+
+@_njit
+def values_over_pieces(t: NDArray, slo: NDArray, shi: NDArray, glo: NDArray, ghi: NDArray,
+                       wlo: NDArray, whi: NDArray, plo: NDArray, phi: NDArray
+                       ) -> tuple[float, float]:
+    """The hull of the values that trajectories of the scalar tube with ``y' ∈ [w]`` take over
+    the time pieces ``[plo[i], phi[i]] ⊂`` slice ``i`` (each bounded by the polygon between
+    virtual gates at the piece's ends: the cone bounds there, inside the envelope);
+    ``(INF, -INF)`` when there is no piece."""
     ylo, yhi = INF, -INF
-    j0 = min(max(np.searchsorted(t, rlo, side="right") - 1, 0), n - 1)
-    j1 = min(max(np.searchsorted(t, rhi, side="left"), j0 + 1), n)
-    for i in range(j0, j1):
-        a, b = max(t[i], rlo), min(t[i + 1], rhi)
-        if a > b:
+    for i in range(slo.size):
+        a, b = plo[i], phi[i]
+        if not a <= b:
             continue
         va = _cone(t[i], t[i + 1], a, glo[i], ghi[i], glo[i + 1], ghi[i + 1], wlo[i], whi[i])
         vb = _cone(t[i], t[i + 1], b, glo[i], ghi[i], glo[i + 1], ghi[i + 1], wlo[i], whi[i])
@@ -149,7 +152,33 @@ def invert_kernel(t: NDArray, slo: NDArray, shi: NDArray, glo: NDArray, ghi: NDA
         hi = min(shi[i], slice_hi(va[1], vb[1], wlo[i], whi[i], h_dn, h_up))
         lo = max(slo[i], -slice_hi(-va[0], -vb[0], -whi[i], -wlo[i], h_dn, h_up))
         ylo, yhi = min(ylo, lo), max(yhi, hi)
+    return ylo, yhi
+
+
+@_njit
+def invert_kernel(t: NDArray, slo: NDArray, shi: NDArray, glo: NDArray, ghi: NDArray,
+                  wlo: NDArray, whi: NDArray, tlo: float, thi: float, zlo: float, zhi: float
+                  ) -> tuple[float, float, float, float]:
+    """``[t] ∩ [y]^{-1}([z])`` with the derivative, for a scalar tube: the hull of the pieces
+    of :func:`invert_pieces`, and ``[z]`` ∩ the values over them
+    (:func:`values_over_pieces`). Returns ``(t_lo, t_hi, z_lo, z_hi)``, ``t_lo > t_hi`` when
+    no trajectory meets ``[z]`` in ``[t]``."""
+    plo, phi = np.full(slo.size, -INF), np.full(slo.size, INF)
+    invert_pieces(t, slo, shi, glo, ghi, wlo, whi, tlo, thi, zlo, zhi, plo, phi)
+    rlo, rhi = _pieces_hull(plo, phi)
+    if not rlo <= rhi:
+        return INF, -INF, INF, -INF
+    ylo, yhi = values_over_pieces(t, slo, shi, glo, ghi, wlo, whi, plo, phi)
     return rlo, rhi, max(ylo, zlo), min(yhi, zhi)
+
+
+@_njit
+def _pieces_hull(plo: NDArray, phi: NDArray) -> tuple[float, float]:
+    rlo, rhi = INF, -INF
+    for i in range(plo.size):
+        if plo[i] <= phi[i]:
+            rlo, rhi = min(rlo, plo[i]), max(rhi, phi[i])
+    return rlo, rhi
 
 
 @_njit
@@ -327,7 +356,10 @@ class CtcEval:
 
     ``contract(t, z, y, w)`` contracts the scalar intervals ``t`` and ``z`` and the tube ``y`` in
     place (``w`` is unchanged) and returns ``(t, z)``. For a tube vector, ``z`` is a box and the
-    constraint holds componentwise at the same time ``t``. When the measurement cannot be met,
+    constraint holds componentwise at the same time ``t``: the times are those at which every
+    component may meet its ``[z_j]``, intersected slice by slice (not the hull of each
+    component's times, which would lose the dependency on ``t``), and ``[z_j]`` the values of
+    component ``j`` over them. When the measurement cannot be met,
     ``t``, ``z`` and ``y`` all become empty.
 
     Only the slices of ``w`` are read: the derivative may jump at every gate (a tube with
@@ -342,8 +374,8 @@ class CtcEval:
         envelope) meets ``[z]``, so ``[t]`` shrinks inside a slice; ``[z]`` to the values of
         those trajectories over the new ``[t]`` (virtual gates at its bounds); and both again
         after the tube is contracted (as Codac's ``CtcEval`` does with ``y.invert(z, w, t)``).
-        ``False``: the plain tube inverse ``[y]^{-1}([z])`` (whole slices) and ``[y]([t])``,
-        once; cheaper, wider.
+        ``False``: the plain tube inverse ``[y]^{-1}([z])`` (whole slices and gates) and
+        ``[y]`` over them, once; cheaper, wider.
 
     Examples
     --------
@@ -381,19 +413,8 @@ class CtcEval:
         zhi = np.array(z.hi, dtype=np.float64).reshape(-1)
         if ok and self.time_deriv:
             ok, tl, th = _invert_all(comps, wcomps, tl, th, zlo, zhi)
-        elif ok:  # [t] ∩ [y]^{-1}([z]) for every component, then [z] ∩ [y]([t])
-            for yj, zj in zip(comps, [Interval(a, b) for a, b in zip(zlo, zhi, strict=True)],
-                              strict=True):
-                inv = yj.inverse(zj, hull=True, within=Interval(tl, th))
-                if inv.is_empty():
-                    ok = False
-                    break
-                tl, th = float(inv.lo), float(inv.hi)
-            if ok:
-                znew = z & y(Interval(tl, th))
-                zlo = np.array(znew.lo, dtype=np.float64).reshape(-1)
-                zhi = np.array(znew.hi, dtype=np.float64).reshape(-1)
-                ok = not np.any(np.isnan(zlo))
+        elif ok:  # [t] ∩ [y]^{-1}([z]) and [z] ∩ [y]([t]), slices and gates common to all
+            ok, tl, th = _plain_invert_all(y, tl, th, zlo, zhi)
         if ok:
             for j, (yj, wj) in enumerate(zip(comps, wcomps, strict=True)):
                 ok = eval_kernel(yj.t, yj.slices.lo, yj.slices.hi, yj.gates.lo, yj.gates.hi,
@@ -417,17 +438,58 @@ class CtcEval:
 
 def _invert_all(comps: list[Tube], wcomps: list[Tube], tl: float, th: float, zlo: NDArray,
                 zhi: NDArray) -> tuple[bool, float, float]:
-    """``[t]`` by :func:`invert_kernel` over every component (one time for all), then each
-    ``[z_j]`` over the final ``[t]``, in place. Returns ``(ok, t_lo, t_hi)``."""
-    for _ in range(2):  # the second pass: every [z_j] over the [t] of all components
-        for j, (yj, wj) in enumerate(zip(comps, wcomps, strict=True)):
-            a, b, c, d = invert_kernel(yj.t, yj.slices.lo, yj.slices.hi, yj.gates.lo,
-                                       yj.gates.hi, wj.slices.lo, wj.slices.hi, tl, th,
-                                       float(zlo[j]), float(zhi[j]))
-            if not (a <= b and c <= d):
-                return False, tl, th
-            tl, th = max(tl, a), min(th, b)
-            zlo[j], zhi[j] = c, d
-        if len(comps) == 1:
-            break
-    return True, tl, th
+    """``[t]`` and every ``[z_j]`` by the time pieces common to all components
+    (:func:`invert_pieces`, slice by slice: the same ``t`` for every component), ``[t]`` their
+    hull and ``[z_j]`` the values of component ``j`` over them, in place. Returns
+    ``(ok, t_lo, t_hi)``."""
+    n = comps[0].n_slices
+    plo, phi = np.full(n, -INF), np.full(n, INF)
+    for j, (yj, wj) in enumerate(zip(comps, wcomps, strict=True)):
+        invert_pieces(yj.t, yj.slices.lo, yj.slices.hi, yj.gates.lo, yj.gates.hi,
+                      wj.slices.lo, wj.slices.hi, tl, th, float(zlo[j]), float(zhi[j]), plo,
+                      phi)
+    a, b = _pieces_hull(plo, phi)
+    if not a <= b:
+        return False, tl, th
+    for j, (yj, wj) in enumerate(zip(comps, wcomps, strict=True)):
+        c, d = values_over_pieces(yj.t, yj.slices.lo, yj.slices.hi, yj.gates.lo, yj.gates.hi,
+                                  wj.slices.lo, wj.slices.hi, plo, phi)
+        c, d = max(c, float(zlo[j])), min(d, float(zhi[j]))
+        if not c <= d:
+            return False, tl, th
+        zlo[j], zhi[j] = c, d
+    return True, max(tl, a), min(th, b)
+
+
+def _plain_invert_all(y: Tube, tl: float, th: float, zlo: NDArray, zhi: NDArray
+                      ) -> tuple[bool, float, float]:
+    """``[t] ∩ [y]^{-1}([z])`` on whole slices and gates (no derivative): the slices meeting
+    ``]tl, th[`` and the gates in ``[tl, th]`` where every component meets its ``[z_j]`` (the
+    same time for all: a hull per component would lose that dependency); ``[t]`` their hull
+    within ``[tl, th]``, ``[z_j]`` ∩ the hull of component ``j`` over them, in place.
+    Returns ``(ok, t_lo, t_hi)``."""
+    t = y.t
+    d = zlo.size
+
+    def common(v: Interval) -> tuple[NDArray, NDArray, NDArray]:
+        lo, hi = np.asarray(v.lo).reshape(-1, d), np.asarray(v.hi).reshape(-1, d)
+        return np.all((lo <= zhi) & (hi >= zlo), axis=1), lo, hi
+
+    if tl == th:
+        hit, lo, hi = common(y._eval_points(np.array([tl])))
+        starts = ends = np.array([tl])
+    else:
+        i0, i1 = y.slice_range(tl, th)
+        g0 = int(np.searchsorted(t, tl, side="left"))
+        g1 = int(np.searchsorted(t, th, side="right"))
+        ms, slo, shi = common(y.slices[i0:i1])
+        mg, glo, ghi = common(y.gates[g0:g1])
+        hit = np.concatenate([ms, mg])
+        lo, hi = np.concatenate([slo, glo]), np.concatenate([shi, ghi])
+        starts = np.concatenate([np.maximum(t[i0:i1], tl), t[g0:g1]])
+        ends = np.concatenate([np.minimum(t[i0 + 1:i1 + 1], th), t[g0:g1]])
+    if not hit.any():
+        return False, tl, th
+    zlo[:] = np.maximum(zlo, lo[hit].min(axis=0))
+    zhi[:] = np.minimum(zhi, hi[hit].max(axis=0))
+    return bool(np.all(zlo <= zhi)), float(starts[hit].min()), float(ends[hit].max())
