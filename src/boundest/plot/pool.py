@@ -121,7 +121,7 @@ def plot_pool_snapshot(data: PoolData, res: PoolResult, k: int,
         cells = res.paving[k, : min(int(res.cells[k]), res.paving.shape[-2])]
         what = "heading slices" if res.eps and res.eps[1] is not None else "paving cells"
         # the box is a few pixels wide at the pool's scale: its cells are drawn in a zoom
-        ins = ax.inset_axes([0.015, 0.6, 0.3, 0.38], zorder=6)
+        ins = ax.inset_axes([0.075, 0.56, 0.27, 0.41], zorder=6)  # tick labels inside ax
         _rects(ins, b.lo[None, :2], b.hi[None, :2], facecolor=BOX, edgecolor=PATH, alpha=0.5,
                lw=1)
         _rects(ins, cells.lo[:, :2], cells.hi[:, :2], facecolor="none", edgecolor=CELL, lw=0.8,
@@ -133,7 +133,6 @@ def plot_pool_snapshot(data: PoolData, res: PoolResult, k: int,
         ins.set_ylim(mid[1] - half, mid[1] + half)
         ins.set_aspect("equal")
         ins.tick_params(labelsize=6, pad=1)
-        ins.set_title(f"zoom: the box and its {what}", fontsize=7, pad=2)
         ax.indicate_inset_zoom(ins, edgecolor="0.3")
         ax.plot([], [], "s", mfc="none", mec=CELL,
                 label=f"{what} kept ({int(res.cells[k])}; zoom, top left)")
