@@ -286,6 +286,11 @@ def test_set_sequence_says_when_a_set_spans_the_frame_and_draws_specks_in_colour
                             ["causal (RCSE)", "non-causal (NCSE)"], FRAME)
     k0, k1 = fig.axes[1], fig.axes[2]
     assert "spans the frame" in k0.get_title() and "spans" not in k1.get_title()
+    # a box as tall as most of the frame but narrow is framed as usual, without the note
+    fig2 = plot_set_sequence([[FRAME, bd.Interval([-0.1, -3.0], [0.1, 3.0])]] * 2,
+                             ["causal (RCSE)", "non-causal (NCSE)"], FRAME)
+    assert "spans" in fig2.axes[1].get_title() and "spans" not in fig2.axes[2].get_title()
+    plt.close(fig2)
     boundary = to_rgba(SET_STYLES[1][1])
     drawn = [c for c in k0.collections if len(c.get_facecolor())
              and tuple(c.get_facecolor()[0]) == boundary]

@@ -173,7 +173,7 @@ def plot_set_sequence(rows: Sequence[Sequence[Interval | Subpaving]],
         empty = [short[r] for r, row in enumerate(rows) if k < len(row) and _is_empty(row[k])]
         if empty:
             notes.insert(0, f"{', '.join(empty)}: empty")
-        elif h is not None and bool(np.all(view.hi - view.lo >= 0.9 * (fh - fl))):
+        elif h is not None and bool(np.all(h.hi - h.lo >= 0.9 * (fh - fl))):
             notes.insert(0, f"{short[-1]} spans the frame: not zoomed")
         ax.set_xlim(float(view.lo[0]), float(view.hi[0]))
         ax.set_ylim(float(view.lo[1]), float(view.hi[1]))
