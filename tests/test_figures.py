@@ -316,3 +316,25 @@ def test_auv_map_marks_the_gps_fixes_it_lists():
     np.testing.assert_allclose(ln.get_xdata(), c[:, 1])
     np.testing.assert_allclose(ln.get_ydata(), c[:, 0])
     plt.close(fig)
+
+
+def test_pool_snapshot_box_fill_lies_under_the_map_and_the_rays():
+    """The window observer's box covers most of the pool: filled over the map it hid the
+    pillars, and over the kept rays it gave them the grey of the rejected ones."""
+    from matplotlib.collections import LineCollection
+    from matplotlib.colors import to_rgba
+    from matplotlib.patches import Circle
+
+    from boundest.plot.pool import BOX, plot_pool_snapshot
+
+    data, res = _pool_result(window_only=True)
+    fig, ax = plt.subplots(figsize=(5, 2.6))
+    plot_pool_snapshot(data, res, data.n - 1, np.ones(data.n, dtype=bool), ax=ax, pings=True)
+    fills = [c for c in ax.collections if len(c.get_facecolor())
+             and tuple(c.get_facecolor()[0][:3]) == to_rgba(BOX)[:3]]
+    rays = [c for c in ax.collections if isinstance(c, LineCollection)]
+    pillars = [p for p in ax.patches if isinstance(p, Circle)]
+    assert fills and rays and pillars
+    top = max(c.get_zorder() for c in fills)
+    assert top < min(c.get_zorder() for c in rays + pillars)
+    plt.close(fig)

@@ -114,8 +114,11 @@ def plot_pool_snapshot(data: PoolData, res: PoolResult, k: int,
         ax.plot([], [], color=REJECTED, lw=1.6,
                 label=f"rejected ping ({int((~ok).sum())})")
     b = res.boxes[k]
-    _rects(ax, b.lo[None, :2], b.hi[None, :2], facecolor=BOX, edgecolor=PATH, alpha=0.7, lw=1,
-           zorder=4)
+    # the fill under the map and the rays (a wide box, as the window observer's, hid the
+    # pillars and tinted the kept rays the grey of the rejected ones), its outline over them
+    _rects(ax, b.lo[None, :2], b.hi[None, :2], facecolor=BOX, edgecolor="none", alpha=0.7,
+           zorder=1)
+    _rects(ax, b.lo[None, :2], b.hi[None, :2], facecolor="none", edgecolor=PATH, lw=1, zorder=4)
     ax.plot([], [], "s", color=BOX, alpha=0.7, mec=PATH, label="(x, y) box at this time")
     if res.paving is not None and res.cells[k]:
         cells = res.paving[k, : min(int(res.cells[k]), res.paving.shape[-2])]
