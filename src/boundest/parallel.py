@@ -34,6 +34,8 @@ from typing import Any
 
 import numpy as np
 
+from ._progress import Progress
+
 __all__ = ["BatchTable", "TaskError", "client_executor", "executor_workers", "map_chunked",
            "run_batch"]
 
@@ -131,7 +133,8 @@ def map_chunked(fn: Callable[[Any], Any], items: Iterable[Any],
         Items per task (default: about four tasks per worker of the executor; the results do
         not depend on it).
     progress : bool or None
-        A tqdm bar over the items, advanced as tasks finish (None: only on a terminal).
+        A progress bar over the items, advanced as tasks finish (False: none; drawn on a
+        terminal only).
     desc : str, optional
         The bar's label.
     stats : dict, optional
@@ -149,8 +152,6 @@ def map_chunked(fn: Callable[[Any], Any], items: Iterable[Any],
         When a call raises (or a task cannot be run): the failing input's index and repr and the
         error; the tasks not started yet are cancelled.
     """
-    from tqdm.auto import tqdm  # here, not at import: boundest's import stays light
-
     items = list(items)
     n = len(items)
     if chunk is None:
@@ -160,8 +161,7 @@ def map_chunked(fn: Callable[[Any], Any], items: Iterable[Any],
     starts = list(range(0, n, chunk))
     parts: list[Any] = [None] * len(starts)
     t0 = time.perf_counter()
-    with tqdm(total=n, desc=desc, disable=None if progress is None else not progress,
-              leave=False) as bar:
+    with Progress(progress, desc=desc, total=n, delay=0.0) as bar:
         if executor is None:
             for i, s in enumerate(starts):
                 parts[i] = _chunk_task(fn, s, items[s:s + chunk])

@@ -94,7 +94,7 @@ def draw_figure(res, out: str) -> None:
     fig = plot_set_sequence([res.rcse.x, res.ncse.x], ["causal (RCSE)", "non-causal (NCSE)"],
                             jw.FRAME)
     fig.suptitle(f"x(k), k = 0..{K}: causal and non-causal sets (Jaulin et al. 2001, Fig. 7);\n"
-                 "each panel zoomed on the non-causal set (ticks differ)", fontsize=10)
+                 "each panel framed on the non-causal set (ticks differ)", fontsize=10)
     save_figure(fig, out, f"jaulin2001_{res.domains}", dpi=110)
 
 

@@ -201,6 +201,11 @@ def _run(args: argparse.Namespace, figures: FigureWorker) -> int:
     return 1 if res.empty.all() else 0
 
 
+def _observer(args: argparse.Namespace) -> str:
+    """The observer a figure shows, for its title."""
+    return "pure window observer" if args.window_only else "recursive observer"
+
+
 def draw_snapshots(data, res, consistent, args: argparse.Namespace) -> None:
     """``pool_snapshots.png``: the (x, y) box at six times, the window's pings on the last."""
     import numpy as np
@@ -223,7 +228,8 @@ def draw_snapshots(data, res, consistent, args: argparse.Namespace) -> None:
     handles, labels = axes.flat[len(snaps) - 1].get_legend_handles_labels()
     fig.legend(handles, labels, loc="lower center", bbox_to_anchor=(0.5, 0.005), ncol=4,
                fontsize=8, frameon=False)
-    fig.suptitle(f"pool robot, q = {args.q}, m = {args.m}: the (x, y) box at six times.\n"
+    fig.suptitle(f"pool robot, {_observer(args)}, q = {args.q}, m = {args.m}: the (x, y) box "
+                 "at six times.\n"
                  "Last panel: each ping of the window drawn from the box centre at its time "
                  "along theta_centre + alpha, length d_mid; grey: the ray-cast contractor "
                  "empties (X_j, ping j)", fontsize=10)
@@ -247,7 +253,7 @@ def draw_trajectory(data, res, consistent, args: argparse.Namespace) -> None:  #
 
     fig, (ax1, ax2) = subplots(2, 1, figsize=(10, 8.5), gridspec_kw={"height_ratios": [1.6, 1]})
     plot_pool_trajectory(data, res, ax=ax1)
-    ax1.set_title(f"trajectory envelope (q = {args.q}, m = {args.m})")
+    ax1.set_title(f"trajectory envelope, {_observer(args)} (q = {args.q}, m = {args.m})")
     plot_pool_widths(data, res, ax=ax2)
     ax2.set_title("widths of the state box against time")
     save_figure(fig, args.out, "pool_trajectory")

@@ -71,26 +71,86 @@ def _run(args: argparse.Namespace, figures: FigureWorker) -> int:
 
 
 def draw_figure(res, k_max: int, out: str) -> None:
-    """``out/satellite_k{k_max}.png``: the boxes of the position (Jaulin 2002, Fig. 4)."""
+    """``out/satellite_k{k_max}.png``: the boxes of the position (Jaulin 2002, Fig. 4).
+
+    The canvas takes the shape of the orbit (a long strip for ``k_max = 800``, not a square
+    around it), and the ``k = 0`` and ``k = k_max`` labels go where they cover no box, no tick
+    label and not the earth (:func:`_place_labels`).
+    """
     from ..interval import Interval
     from ..plot import plot_boxes
 
-    fig, ax = subplots(figsize=(6.5, 6))
-    plot_boxes(Interval.trusted(res.x_lo[:, 0], res.x_hi[:, 0]),
-               Interval.trusted(res.x_lo[:, 1], res.x_hi[:, 1]), ax=ax,
+    lo, hi = res.x_lo[:, :2], res.x_hi[:, :2]
+    x0, y0 = min(float(lo[:, 0].min()), 0.0), min(float(lo[:, 1].min()), 0.0)
+    x1, y1 = max(float(hi[:, 0].max()), 0.0), max(float(hi[:, 1].max()), 0.0)
+    pad = 0.04 * max(x1 - x0, y1 - y0)
+    x0, x1, y0, y1 = x0 - pad, x1 + pad, y0 - pad, y1 + pad
+    # the canvas takes the data's aspect ratio (equal scales): at most 6 inches either way
+    ratio = (y1 - y0) / (x1 - x0)
+    width = min(6.0, 6.0 / ratio)
+    height = max(width * ratio, 1.2)
+    fig, ax = subplots(figsize=(width + 1.0, height + 1.2))
+    plot_boxes(Interval.trusted(lo[:, 0], hi[:, 0]), Interval.trusted(lo[:, 1], hi[:, 1]), ax=ax,
                label="box [x1](k) x [x2](k), one per k")
-    ax.plot(0, 0, "o", color="tab:green", ms=10, label="earth")
+    ax.plot(0, 0, "o", color="tab:green", ms=8, label="earth", zorder=1)
+    ax.set_xlim(x0, x1)
+    ax.set_ylim(y0, y1)
     ax.set_xlabel("x1 (length unit of the model, G M = 1)")
     ax.set_ylabel("x2 (length unit of the model)")
     ax.set_aspect("equal")
     ax.set_title(f"[x1](k) x [x2](k), k = 0..{k_max} (Jaulin 2002, Fig. 4)")
-    for k, dx in ((0, -12), (k_max, -12)):
-        b = res.box(k)
-        ax.annotate(f"k = {k}", ((b.lo[0] + b.hi[0]) / 2, (b.lo[1] + b.hi[1]) / 2),
-                    xytext=(dx, 0), textcoords="offset points", ha="right", va="center",
-                    fontsize=9, arrowprops=dict(arrowstyle="-", color="0.3", lw=0.8))
-    ax.legend(loc="center", bbox_to_anchor=(0.55, 0.45), fontsize=8)
+    ax.legend(loc="best", fontsize=8)
+    fig.tight_layout()
+    _place_labels(ax, [(k, res.box(k)) for k in (0, k_max)], (lo + hi) / 2)
     save_figure(fig, out, f"satellite_k{k_max}")
+
+
+def _place_labels(ax, boxes: list, centres) -> list:
+    """Label each ``(k, box)`` with ``"k = {k}"`` and a leader line, at the one of eight
+    positions around the box whose text stays inside the axes and covers the fewest box
+    centres, the earth, the legend and the labels already placed. Returns the annotations."""
+    import numpy as np
+
+    fig = ax.figure
+    renderer = fig.canvas.get_renderer()
+    ax.apply_aspect()
+    pts = ax.transData.transform(np.vstack([centres, [[0.0, 0.0]]]))
+    frame = ax.get_window_extent(renderer)
+    legend = ax.get_legend()
+    taken = [legend.get_window_extent(renderer)] if legend is not None else []
+    from matplotlib.text import Text
+    from matplotlib.transforms import Bbox
+
+    ex, ey = ax.transData.transform((0.0, 0.0))
+    r = 6 * fig.dpi / 72  # the earth marker's radius (4 points) and a margin
+    earth = Bbox.from_extents(ex - r, ey - r, ex + r, ey + r)
+    done = []
+    for k, b in boxes:
+        xy = ((b.lo[0] + b.hi[0]) / 2, (b.lo[1] + b.hi[1]) / 2)
+        best = None
+        for angle in np.arange(8) * np.pi / 4 + np.pi / 8:
+            dx, dy = 22 * np.cos(angle), 22 * np.sin(angle)
+            ann = ax.annotate(f"k = {k}", xy, xytext=(dx, dy), textcoords="offset points",
+                              ha="left" if dx > 0 else "right",
+                              va="bottom" if dy > 0 else "top", fontsize=9,
+                              arrowprops=dict(arrowstyle="-", color="0.3", lw=0.8))
+            ann.update_positions(renderer)
+            ext = Text.get_window_extent(ann, renderer).expanded(1.1, 1.2)  # not the line
+            inside = frame.x0 <= ext.x0 and ext.x1 <= frame.x1 and frame.y0 <= ext.y0 \
+                and ext.y1 <= frame.y1
+            covered = int(np.count_nonzero((pts[:, 0] >= ext.x0) & (pts[:, 0] <= ext.x1)
+                                           & (pts[:, 1] >= ext.y0) & (pts[:, 1] <= ext.y1)))
+            hit = sum(ext.overlaps(t) for t in [*taken, earth])
+            score = (0 if inside else 10_000) + covered + 1_000 * hit
+            if best is None or score < best[0]:
+                if best is not None:
+                    best[1].remove()
+                best = (score, ann, ext)
+            else:
+                ann.remove()
+        taken.append(best[2])
+        done.append(best[1])
+    return done
 
 
 def register(runs: argparse._SubParsersAction) -> None:

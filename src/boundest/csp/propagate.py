@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._progress import Progress
 from ..expr.model import Model
 from ..expr.nodes import Constraint, Var, VarFamily
 from ..expr.tape import Tape, compile_model
@@ -433,8 +434,8 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
     domains : dict, optional
         Domains narrowing the model's initial ones (keyed by variable name or ``Var``).
     progress : bool, optional
-        Show a progress counter of node revisions and dirty nodes (default: only when the run
-        lasts more than 2 s).
+        Show a progress counter of node revisions and dirty nodes, on a terminal only
+        (default: only when the run lasts more than 2 s).
     chunk : int
         Node revisions per call of the compiled kernel (between progress updates).
     window : int
@@ -520,23 +521,18 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
                      0, 0.0, window, np.zeros(len(SHAVE_STATS), dtype=np.int64), *families)
     t0 = time.perf_counter()
     status = EMPTY if np.isnan(lo).any() or (lo > hi).any() else RUNNING
-    bar = None
-    while status == RUNNING and state[3] < budget and n > 0:
-        status = propagate_kernel(tape.op, tape.out, tape.a, tape.b, tape.param, lo, hi, ptr,
-                                  adj, dirty, state, rel_eps, min(chunk, budget - state[3]),
-                                  window, *families)
-        if bar is None and status == RUNNING and (progress or (
-                progress is None and time.perf_counter() - t0 > 2.0)):
-            from tqdm import tqdm
-
-            # no total: the budget is a cap, not a forecast of the revisions to the fixed
-            # point; the bar counts revisions and shows how many nodes are still dirty
-            bar = tqdm(unit="rev", unit_scale=True, desc="propagating", leave=False)
-        if bar is not None:
+    # no total: the budget is a cap, not a forecast of the revisions to the fixed point; the
+    # bar counts revisions and shows how many nodes are still dirty
+    with Progress(progress if n > 0 else False, desc="propagating", unit="rev",
+                  unit_scale=True) as bar:
+        while status == RUNNING and state[3] < budget and n > 0:
+            status = propagate_kernel(tape.op, tape.out, tape.a, tape.b, tape.param, lo, hi,
+                                      ptr, adj, dirty, state, rel_eps,
+                                      min(chunk, budget - state[3]), window, *families)
             bar.update(int(state[3]) - bar.n)
             bar.set_postfix(dirty=int(state[1]))
-    if bar is not None:
-        bar.close()
+        bar.stop("empty: the constraints are inconsistent" if status == EMPTY else
+                 f"revision budget ({budget}) spent" if status == RUNNING else "fixed point")
     evaluations = int(state[3])
     shave_info: dict = {}
     bc_info: dict = {}

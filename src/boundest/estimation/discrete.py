@@ -31,6 +31,7 @@ from typing import Any
 
 import numpy as np
 
+from .._progress import Progress
 from ..csp.tree import Arc, TreeSCSP
 from ..ctc.base import _empty_rows
 from ..interval import Interval
@@ -193,15 +194,11 @@ def _setup(system: DiscreteSystem, y: Interval, x0: Interval | None, x_prior: In
     return K, ops, xs, ys, meas
 
 
-def _progress(total: int, desc: str, show: bool) -> tuple[Callable[[], None], Any]:
+def _progress(total: int, desc: str, show: bool) -> tuple[Callable[[], None], Progress]:
     """A tick per local operator call and its bar; ``total`` must be the exact number of calls
     (``_calls``), so that the bar ends at its total."""
-    if not show:
-        return (lambda: None), None
-    from tqdm import tqdm
-
-    bar = tqdm(total=total, desc=desc, unit="op", leave=False)
-    return (lambda: bar.update(1)), bar
+    bar = Progress(show, desc=desc, total=total, unit="op")
+    return bar.update, bar
 
 
 def _calls(K: int, ops: BoxSets | PavingSets, estimator: str) -> int:
@@ -233,7 +230,7 @@ def ncse(system: DiscreteSystem, y: Interval, *, x0: Interval | None = None,
         (``(..., K + 1, nx)`` / ``(..., K, ny)``); default ``R^n``.
     domains : {"boxes", "subpavings"}
     eps, max_boxes : subpaving precision and per-operator box budget (``PavingSets``).
-    progress : show a progress bar over the local operators.
+    progress : show a progress bar over the local operators (on a terminal only).
 
     Returns
     -------
@@ -246,9 +243,8 @@ def ncse(system: DiscreteSystem, y: Interval, *, x0: Interval | None = None,
     t0 = time.perf_counter()
     doms: dict = {_xn(k): xs[k] for k in range(K + 1)}
     doms.update({_yn(k): ops.intersect(ys[k - 1], meas[k - 1]) for k in range(1, K + 1)})
-    doms = tree.fall_climb(doms, root=_xn(K))
-    if bar is not None:
-        bar.close()
+    with bar:
+        doms = tree.fall_climb(doms, root=_xn(K))
     return ChainEstimate([doms[_xn(k)] for k in range(K + 1)],
                          [doms[_yn(k)] for k in range(1, K + 1)], ops.name,
                          time.perf_counter() - t0, _stats(ops))
@@ -305,24 +301,23 @@ def rcse_ncse(system: DiscreteSystem, y: Interval, *, x0: Interval | None = None
     tree = _chain(system, K, ops, tick)
     arcs = {(a.a, a.b): a for a in tree.arcs}
     t0 = time.perf_counter()
-    doms = _initial(tree, ops, xs, ys, K)
-    out_x, out_y = [doms[_xn(0)]], []
-    for k in range(1, K + 1):
-        doms[_yn(k)] = ops.intersect(doms[_yn(k)], meas[k - 1])           # step 5
-        doms[_xn(k)] = arcs[(_xn(k), _yn(k))].contract(_xn(k), doms)         # step 6
-        doms[_xn(k)] = arcs[(_xn(k - 1), _xn(k))].contract(_xn(k), doms)
-        doms[_yn(k)] = arcs[(_xn(k), _yn(k))].contract(_yn(k), doms)         # step 7
-        out_x.append(doms[_xn(k)])
-        out_y.append(doms[_yn(k)])
-    causal = ChainEstimate(out_x, out_y, ops.name, time.perf_counter() - t0, _stats(ops))
-    smoothed = None
-    if smooth:
-        doms = tree.climb(doms, root=_xn(K))
-        smoothed = ChainEstimate([doms[_xn(k)] for k in range(K + 1)],
-                                 [doms[_yn(k)] for k in range(1, K + 1)], ops.name,
-                                 time.perf_counter() - t0, _stats(ops))
-    if bar is not None:
-        bar.close()
+    with bar:
+        doms = _initial(tree, ops, xs, ys, K)
+        out_x, out_y = [doms[_xn(0)]], []
+        for k in range(1, K + 1):
+            doms[_yn(k)] = ops.intersect(doms[_yn(k)], meas[k - 1])           # step 5
+            doms[_xn(k)] = arcs[(_xn(k), _yn(k))].contract(_xn(k), doms)         # step 6
+            doms[_xn(k)] = arcs[(_xn(k - 1), _xn(k))].contract(_xn(k), doms)
+            doms[_yn(k)] = arcs[(_xn(k), _yn(k))].contract(_yn(k), doms)         # step 7
+            out_x.append(doms[_xn(k)])
+            out_y.append(doms[_yn(k)])
+        causal = ChainEstimate(out_x, out_y, ops.name, time.perf_counter() - t0, _stats(ops))
+        smoothed = None
+        if smooth:
+            doms = tree.climb(doms, root=_xn(K))
+            smoothed = ChainEstimate([doms[_xn(k)] for k in range(K + 1)],
+                                     [doms[_yn(k)] for k in range(1, K + 1)], ops.name,
+                                     time.perf_counter() - t0, _stats(ops))
     return causal, smoothed
 
 

@@ -51,7 +51,10 @@ def plot_auv_map(data: AuvData, results: list[AuvResult], truth: AuvTruth | None
     f = data.fix
     _rects(ax, np.stack([f.lo[:, 1], f.lo[:, 0]], 1), np.stack([f.hi[:, 1], f.hi[:, 0]], 1),
            facecolor="none", edgecolor=GPS, lw=1.5)
-    ax.plot([], [], "s", mfc="none", mec=GPS, label="GPS fix (first, last sample)")
+    # a fix box is metres wide on a map of kilometres: a marker at its centre shows where it is
+    fc = f.mid()
+    ax.plot(fc[:, 1], fc[:, 0], "s", mfc="none", mec=GPS, ms=8, mew=1.5, ls="none", zorder=4,
+            label="GPS fix (first, last sample)")
     slam = [r for r in results if r.mode == "slam" and r.consistent]
     if slam:
         m, p = slam[0].mines, slam[0].positions

@@ -40,9 +40,16 @@ def _hull(d: Interval | Subpaving, frame: Interval) -> Interval | None:
 
 
 def _draw(d: Interval | Subpaving, ax: Any, frame: Interval,
-          style: tuple[str, str, str, str], name: str) -> None:
+          style: tuple[str, str, str, str], name: str, points: float = np.inf) -> None:
+    """Draw ``d`` in ``style``; ``points``: the size of one unit of the view, in points."""
     inside, boundary, edge, hatch = style
     if isinstance(d, Subpaving):
+        if not d.is_empty():
+            # boxes narrower than 2 points would show their edges only: black lines the legend
+            # does not explain; edges in the boxes' own colours keep them in the legend's
+            side = float(np.median(np.max(d.boxes.width()[:, :2], axis=1)))
+            if side * points < 2.0:
+                edge = "face"
         plot_paving(d, ax=ax, inside=inside, boundary=boundary, edgecolor=edge, linewidth=0.3,
                     labels=(f"{name}: inside (proven in the set)",
                             f"{name}: boundary (undecided at eps)", None))
@@ -95,10 +102,11 @@ def plot_set_sequence(rows: Sequence[Sequence[Interval | Subpaving]],
     matplotlib.figure.Figure
         The first panel shows every step ``k >= 1`` of the last estimator in the frame, in a
         colour scale of ``k``. Each following panel is framed on the last estimator's set at
-        step ``k`` (a square view around its hull, with ticks), where both estimators are drawn
-        with their inside boxes (proven in the set) and boundary boxes (undecided at the
-        precision eps) in the colours of the legend; boxes of an earlier estimator lying
-        outside that view are counted in the panel.
+        step ``k`` (a square view around its hull, with ticks; the frame, said in the panel's
+        title, where that hull spans it), where both estimators are drawn with their inside
+        boxes (proven in the set) and boundary boxes (undecided at the precision eps) in the
+        colours of the legend (boxes too small for their edges drawn in their own colour);
+        boxes of an earlier estimator lying outside that view are counted in the panel.
     """
     import matplotlib as mpl
     import matplotlib.pyplot as plt
@@ -150,10 +158,11 @@ def plot_set_sequence(rows: Sequence[Sequence[Interval | Subpaving]],
             mid = (h.lo + h.hi) / 2
             half = max(float(np.max(h.hi - h.lo)) / 2 * 1.3, 0.02 * span)
             view = Interval.trusted(np.maximum(mid - half, fl), np.minimum(mid + half, fh))
+        points = panel * 72 / float(np.max(view.hi - view.lo))
         for r, row in enumerate(rows):
             style = SET_STYLES[1 if r == len(rows) - 1 else (0 if r == 0 else 2)]
             if k < len(row):
-                _draw(row[k], ax, frame, style, labels[r])
+                _draw(row[k], ax, frame, style, labels[r], points)
         if truth is not None and k < len(truth):
             ax.plot(truth[k][0], truth[k][1], "x", color="tab:blue", ms=8, mew=2,
                     label="true state")
@@ -164,6 +173,8 @@ def plot_set_sequence(rows: Sequence[Sequence[Interval | Subpaving]],
         empty = [short[r] for r, row in enumerate(rows) if k < len(row) and _is_empty(row[k])]
         if empty:
             notes.insert(0, f"{', '.join(empty)}: empty")
+        elif h is not None and bool(np.all(h.hi - h.lo >= 0.9 * (fh - fl))):
+            notes.insert(0, f"{short[-1]} spans the frame: not zoomed")
         ax.set_xlim(float(view.lo[0]), float(view.hi[0]))
         ax.set_ylim(float(view.lo[1]), float(view.hi[1]))
         ax.set_aspect("equal", adjustable="box")

@@ -61,10 +61,12 @@ def plot_pool_map(data: PoolData, ax: Any = None, legend: bool = True) -> Any:
 
     ax = _axes(ax)
     seg = data.map.segments
+    # above the boxes drawn later (zorder 1): a wide set does not hide the map it is read on
     for s in seg:
-        ax.plot(s[:, 0], s[:, 1], color=WALL, lw=1.5)
+        ax.plot(s[:, 0], s[:, 1], color=WALL, lw=1.5, zorder=3)
     for c, r in zip(data.map.centers, data.map.radii, strict=True):
-        ax.add_patch(Circle((c[0], c[1]), r, facecolor=PILLAR, edgecolor=PILLAR, alpha=0.8))
+        ax.add_patch(Circle((c[0], c[1]), r, facecolor=PILLAR, edgecolor=PILLAR, alpha=0.8,
+                            zorder=3))
     if legend:
         ax.plot([], [], color=WALL, lw=1.5, label="pool wall")
         ax.plot([], [], "o", color=PILLAR, label="pillar")
@@ -112,14 +114,31 @@ def plot_pool_snapshot(data: PoolData, res: PoolResult, k: int,
         ax.plot([], [], color=REJECTED, lw=1.6,
                 label=f"rejected ping ({int((~ok).sum())})")
     b = res.boxes[k]
-    _rects(ax, b.lo[None, :2], b.hi[None, :2], facecolor=BOX, edgecolor=PATH, alpha=0.7, lw=1,
-           zorder=4)
+    # the fill under the map and the rays (a wide box, as the window observer's, hid the
+    # pillars and tinted the kept rays the grey of the rejected ones), its outline over them
+    _rects(ax, b.lo[None, :2], b.hi[None, :2], facecolor=BOX, edgecolor="none", alpha=0.7,
+           zorder=1)
+    _rects(ax, b.lo[None, :2], b.hi[None, :2], facecolor="none", edgecolor=PATH, lw=1, zorder=4)
     ax.plot([], [], "s", color=BOX, alpha=0.7, mec=PATH, label="(x, y) box at this time")
     if res.paving is not None and res.cells[k]:
         cells = res.paving[k, : min(int(res.cells[k]), res.paving.shape[-2])]
-        _rects(ax, cells.lo[:, :2], cells.hi[:, :2], facecolor="none", edgecolor=CELL, lw=0.6)
         what = "heading slices" if res.eps and res.eps[1] is not None else "paving cells"
-        ax.plot([], [], "s", mfc="none", mec=CELL, label=f"{what} kept ({int(res.cells[k])})")
+        # the box is a few pixels wide at the pool's scale: its cells are drawn in a zoom
+        ins = ax.inset_axes([0.075, 0.56, 0.27, 0.41], zorder=6)  # tick labels inside ax
+        _rects(ins, b.lo[None, :2], b.hi[None, :2], facecolor=BOX, edgecolor=PATH, alpha=0.5,
+               lw=1)
+        _rects(ins, cells.lo[:, :2], cells.hi[:, :2], facecolor="none", edgecolor=CELL, lw=0.8,
+               zorder=5)
+        lo, hi = b.lo[:2], b.hi[:2]
+        half = 0.6 * float(np.max(hi - lo))
+        mid = (lo + hi) / 2
+        ins.set_xlim(mid[0] - half, mid[0] + half)
+        ins.set_ylim(mid[1] - half, mid[1] + half)
+        ins.set_aspect("equal")
+        ins.tick_params(labelsize=6, pad=1)
+        ax.indicate_inset_zoom(ins, edgecolor="0.3")
+        ax.plot([], [], "s", mfc="none", mec=CELL,
+                label=f"{what} kept ({int(res.cells[k])}; zoom, top left)")
     return ax
 
 
@@ -162,7 +181,8 @@ def plot_pool_trajectory(data: PoolData, res: PoolResult, every: int = 10,
     """The pool, the ``(x, y)`` boxes every ``every`` steps (the envelope) and the centre path."""
     ax = plot_pool_map(data, ax)
     b = res.boxes[::every]
-    _rects(ax, b.lo[:, :2], b.hi[:, :2], facecolor=BOX, edgecolor=BOX, alpha=0.25, lw=0.5)
+    _rects(ax, b.lo[:, :2], b.hi[:, :2], facecolor=BOX, edgecolor=BOX, alpha=0.25, lw=0.5,
+           zorder=1)
     ax.plot([], [], "s", color=BOX, alpha=0.5,
             label=f"(x, y) box every {every} steps ({every * data.dt:g} s)")
     c = res.centre()

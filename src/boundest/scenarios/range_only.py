@@ -36,6 +36,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import interval as iv
+from .._progress import Progress
 from ..expr import Var
 from ..expr import functions as ef
 from ..interval import Interval
@@ -455,14 +456,11 @@ def solve(meas: Measurements | None = None, dt: float = 0.01, rel_eps: float = 1
     diag, contraction = [], []
     converged = empty = False
     iterations = 0
-    from tqdm.auto import tqdm
-
     start = time.perf_counter()
     rep = net.dead_reckoning.contract(rel_eps=rel_eps, max_iter=max_iter, progress=False)
     empty = rep.empty
     # a counter, not a total: the fixed point comes long before the cap (max_iter)
-    with tqdm(desc="range-only", unit="it", delay=2.0 if progress is None else 0.0,
-              disable=progress is False or empty) as bar:
+    with Progress(False if empty else progress, desc="range-only") as bar:
         while iterations < max_iter and not empty:
             rep = net.position.contract(rel_eps=rel_eps, max_iter=1, progress=False)
             iterations += 1
@@ -470,13 +468,17 @@ def solve(meas: Measurements | None = None, dt: float = 0.01, rel_eps: float = 1
             contraction.append(rep.contraction[-1])
             if rep.empty:
                 empty = True
+                bar.stop("empty: the measurements are inconsistent")
                 break
             g = net.x.gates.width()[::step]
             diag.append(np.hypot(g[:, 0], g[:, 1]))
             bar.set_postfix(contraction=f"{contraction[-1]:.2e}", stop_below=f"{rel_eps:.0e}")
             if rep.converged:
                 converged = True
+                bar.stop("converged")
                 break
+        else:
+            bar.stop(f"max_iter={max_iter} reached")
     spent = time.perf_counter() - start
     return RangeOnlyResult(meas, net.x, net.v, net.y, net.w, net.t, net.z, iterations,
                            converged, empty, spent, build_s, contraction, diag_t, diag,

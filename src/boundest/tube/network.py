@@ -17,6 +17,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
+from .._progress import Progress
 from ..ctc import Contractor
 from ..interval import Interval
 from .tube import Tube
@@ -135,26 +136,24 @@ class ContractorNetwork:
         max_iter : int
             Stop after this many iterations.
         progress : bool, optional
-            Show a tqdm progress bar: ``None`` shows it only for runs longer than 2 s.
+            Show a progress bar (on a terminal only): ``None`` shows it only for runs longer
+            than 2 s.
         """
         if not 0.0 <= rel_eps < 1.0 or max_iter < 1:
             raise ValueError(f"need 0 <= rel_eps < 1 and max_iter >= 1, got {rel_eps}, "
                              f"{max_iter}")
-        from tqdm.auto import tqdm
-
         report = NetworkReport()
         start = time.perf_counter()
         before = self._widths()
         # no total: the number of iterations to the fixed point is not known in advance (the
         # cap is not a forecast); the bar counts iterations and shows the last contraction
-        bar = tqdm(desc="contractor network", unit="it", delay=2.0 if progress is None else 0.0,
-                   disable=progress is False)
-        try:
+        with Progress(progress, desc="contractor network") as bar:
             while report.iterations < max_iter:
                 ok = self.contract_once()
                 report.iterations += 1
                 bar.update(1)
                 if not ok:
+                    bar.stop("empty: the constraints are inconsistent")
                     report.empty = True
                     report.contraction.append(1.0)
                     report.newly_bounded.append(0)
@@ -175,8 +174,9 @@ class ContractorNetwork:
                 before = after
                 if ratio < rel_eps and bounded == 0:
                     report.converged = True
+                    bar.stop("converged")
                     break
-        finally:
-            bar.close()
+            else:
+                bar.stop(f"max_iter={max_iter} reached")
         report.time_s = time.perf_counter() - start
         return report
