@@ -463,6 +463,26 @@ def test_float_integer_exponent_keeps_negative_solutions():
     assert mp_in(-2, float(r.lo[0]), float(r.hi[0]))
 
 
+def test_revise_pown_with_huge_tape_exponents():
+    """The compiled image and reverse step of a pown node (``revise``, their composition) take
+    the tape's float64 exponent of any magnitude (an integer-valued float, hence even beyond
+    2**53) as the integer power: ``np.int64(p)`` is undefined beyond 2**63."""
+    from boundest.ctc.revise import POWN, revise
+
+    buf = np.empty(4)
+    # x in [-3, -2]: x**n >= 2**n > MAX for n >= 2**62, and 0 < x**n <= 2**n < 2**-1074 for
+    # n <= -2**62 (n even)
+    for p, (zl, zh) in ((1e20, (MAX, INF)), (2.0**64, (MAX, INF)), (-1e300, (0.0, 2.0**-1074)),
+                        (2.0**62, (MAX, INF)), (-(2.0**63), (0.0, 2.0**-1074))):
+        got = revise(POWN, -INF, INF, -3.0, -2.0, 0.0, 0.0, p, buf, None, True, None, None)
+        assert got[:4] == (zl, zh, -3.0, -2.0), (p, got)
+    # backward: x**1e20 in [0, 1] keeps exactly [-1, 1] (to an ulp)
+    z0, z1, x0, x1 = revise(POWN, 0.0, 1.0, -3.0, 3.0, 0.0, 0.0, 1e20, buf, None, True, None,
+                            None)[:4]
+    assert (z0, z1) == (0.0, 1.0)
+    assert -1.0 - 2**-52 <= x0 <= -1.0 and 1.0 <= x1 <= 1.0 + 2**-52
+
+
 # -------------------------------------------------------------------------------------------
 # 5. composition
 # -------------------------------------------------------------------------------------------

@@ -92,11 +92,12 @@ _SAFE = 1.0 + 2.0**-40
 _LOG2_LIMIT = 1100.0
 #: The kernels take the exponent of pown as an int64 ``n`` with ``|n| < 2**63``; an integer
 #: exponent ``N`` beyond that range stands for ``sign(N) * (_N_HUGE + N % 2)``, an int64 of the
-#: same sign and parity. The two have the same power at every float base: for ``|n| >=
-#: _N_HUGE`` and a float ``a > 0`` other than 1, ``|n log2 a| >= _N_HUGE * 2**-53 / ln 2 > 1400``
-#: (``1 - 2**-53`` is the float ``!= 1`` nearest to 1 in log), so ``a**n`` and ``a**N`` both
-#: lie beyond ``2**1100`` or both below ``2**-1100`` (on the same side), and ``_pow_pos``
-#: decides both alike by that margin (``_LOG2_LIMIT``): ``[MAX, inf]`` or ``[0, ETA]``. The
+#: same sign and parity. The two have the same power at every float base: for ``|n| >= 7e18``
+#: (``_N_HUGE`` and ``_N_HUGE - 1``, the exponent of a derivative, among them) and a float
+#: ``a > 0`` other than 1, ``|n log2 a| >= 7e18 * 2**-53 / ln 2 > 1100`` (``1 - 2**-53`` is the
+#: float ``!= 1`` nearest to 1 in log; at ``_N_HUGE`` the product exceeds 1400), so ``a**n`` and
+#: ``a**N`` both lie beyond ``2**1100`` or both below ``2**-1100`` (on the same side), and
+#: ``_pow_pos`` decides both alike (``_LOG2_LIMIT``): ``[MAX, inf]`` or ``[0, ETA]``. The
 #: bases 0, 1 and inf depend only on the sign, and a negative base only on the parity too; the
 #: roots of ``pown_rev`` are found by comparing such powers of float candidates. Every float
 #: beyond ``2**53`` is even, so a float exponent that large maps to ``+-_N_HUGE``.
