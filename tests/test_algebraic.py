@@ -189,6 +189,100 @@ def test_pown_huge_exponent_contains_exact(a, n, neg, sgn):
         assert mpmath.mpf(float(r.lo)) <= lo and hi <= mpmath.mpf(float(r.hi)), (a, n, r, v)
 
 
+# Exponents beyond int64 (issue 27 item 7): Python integers of any size and integer-valued
+# floats (every float beyond 2**53 is an even integer), around 2**62 .. 2**63 (the kernels'
+# int64 range ends there) and far beyond; bases near 1 are the only floats whose powers stay
+# in range there.
+HUGE_N = st.one_of(
+    st.integers(2**62 - 4, 2**63 + 4), st.integers(2**63, 2**1100),
+    st.floats(2.0**52, 1e300), st.sampled_from(
+        [2**62, 2**62 + 1, 3 * 2**61 + 1, 2**63 - 2, 2**63 - 1, 2**63, 2**63 + 1, 2**64 + 1,
+         10**20, 10**20 + 1, 10**300 + 1, 1e20, 2.0**64, 1e300, 2.0**62, 2.0**63]))
+NEAR_ONE = st.sampled_from([1.0, 1 - 2**-53, 1 - 2**-52, 1 - 2**-50, 1 + 2**-52, 1 + 2**-51,
+                            0.5, 2.0, 5e-324, 1e308])
+
+
+def mp_pown(a: float, n: int) -> tuple[mpmath.mpf, mpmath.mpf]:
+    """A rigorous enclosure (mpmath interval arithmetic, 300 bits) of the real ``a**n``."""
+    with mpmath.workprec(300):
+        v = mpmath.iv.mpf(abs(a)) ** n
+        lo, hi = v.a, v.b
+    if a < 0 and n % 2:
+        lo, hi = -hi, -lo
+    return lo, hi
+
+
+@st.composite
+def huge_pown_case(draw) -> tuple[Interval, float, int | float]:
+    """An interval, a point of it and an integer exponent of magnitude >= 2**52."""
+    if draw(st.booleans()):
+        a = draw(NEAR_ONE) * draw(st.sampled_from([1.0, -1.0]))
+        x = Interval(a)
+    else:
+        x = draw(intervals())
+        a = draw(point_in(x))
+    n = draw(HUGE_N) * draw(st.sampled_from([1, -1]))
+    assume(not (n < 0 and a == 0.0))
+    return x, a, n
+
+
+@settings(max_examples=300, deadline=None)
+@given(case=huge_pown_case())
+def test_pown_beyond_int64_contains_exact(case):
+    """Every integer exponent, however large, is an integer power: the exact real value (its
+    sign from the parity, its magnitude over MAX or under the smallest subnormal) is enclosed,
+    and outside the float range by the tightest enclosure."""
+    x, a, n = case
+    r = alg.pown(x, n)
+    assert valid(r)
+    lo, hi = mp_pown(a, int(n))
+    assert mpmath.mpf(float(r.lo)) <= lo and hi <= mpmath.mpf(float(r.hi)), (x, a, n, r)
+    if float(x.lo) == float(x.hi):  # a degenerate base: the tightest enclosure out of range
+        want = ((MAX, INF) if lo > MAX else (-INF, -MAX) if hi < -MAX
+                else (0.0, ETA) if lo > 0 and hi < ETA else (-ETA, 0.0) if lo > -ETA and hi < 0
+                else None)
+        if want is not None:
+            assert (float(r.lo), float(r.hi)) == want, (a, n, r)
+
+
+@settings(max_examples=200, deadline=None)
+@given(case=huge_pown_case())
+def test_pown_rev_beyond_int64_keeps_solutions(case):
+    x, a, n = case
+    lo, hi = mp_pown(a, int(n))
+    z = Interval(mp_dn(lo), mp_up(hi))
+    check_rev1(x, alg.pown_rev(z, x, n), a)
+
+
+def test_pown_beyond_int64_examples():
+    x = Interval(-3, -2)
+    assert same(alg.pown(x, 1e20), MAX, INF)
+    assert same(alg.pown(x, 2.0**64), MAX, INF)
+    assert same(alg.pown(x, 2**64 + 1), -INF, -MAX)
+    assert same(alg.pown(x, -1e300), 0.0, ETA)
+    assert same(alg.pown(x, -(2**64 + 1)), -ETA, 0.0)
+    assert same(alg.pown(Interval(-1, -1), 2**100 + 1), -1.0, -1.0)
+    assert same(alg.pown(Interval(-1, 1), 1e300), 0.0, 1.0)
+    assert same(alg.pown(Interval(-2, 0.5), -(2**64 + 1)), -INF, INF)
+    assert same(alg.pown(Interval(0, 0.5), 1e300), 0.0, ETA)
+    assert is_empty(alg.pown(Interval(0, 0), -1e300))
+    # the int64 range ends at 2**63: one beyond it, one inside, the same power here
+    assert same(alg.pown(Interval(1 - 2**-53), 2**63 + 1), 0.0, ETA)
+    assert same(alg.pown(Interval(1 - 2**-53), 2**63 - 1), 0.0, ETA)
+    # arrays of exponents: NumPy integers and floats, and Python integers beyond int64
+    r = alg.pown(Interval([-3.0] * 4), np.array([2**70, 2**70 + 1, 2**63 + 1, -(2**63)],
+                                                dtype=object))
+    assert np.array_equal(r.lo, [MAX, -INF, -INF, 0.0]) and np.array_equal(r.hi,
+                                                                            [INF, -MAX, -MAX, ETA])
+    r = alg.pown(Interval([-3.0] * 3), np.array([2.0**64, -1e300, 2.0**62]))
+    assert np.array_equal(r.lo, [MAX, 0.0, MAX]) and np.array_equal(r.hi, [INF, ETA, INF])
+    assert same(alg.pown(x, np.uint64(2**63 + 1)), -INF, -MAX)
+    assert same(alg.pown(x, np.int64(-(2**63))), 0.0, ETA)
+    assert same(alg.pown_rev(Interval(-3, -2), Interval(-5, 5), 2**64 + 1),
+                -1 - 2**-52, -1.0)
+    assert is_empty(alg.pown_rev(Interval(-3, -2), Interval(-5, 5), 2.0**64))
+
+
 @settings(max_examples=400, deadline=None)
 @given(a=st.floats(allow_nan=False, allow_infinity=False), n=st.integers(-40, 40))
 def test_pown_degenerate_is_tightest(a, n):
@@ -216,7 +310,7 @@ def test_pown_array_exponent_broadcasts():
     r = alg.pown(Interval([2.0, 2.0]), np.array([3, -1], dtype=np.int32))
     assert np.array_equal(r.lo, [8.0, 0.5]) and np.array_equal(r.hi, [8.0, 0.5])
     assert same(alg.pown(Interval(2.0), np.uint8(3)), 8.0, 8.0)
-    for bad in (2.5, "2", True, 2**62, np.inf):
+    for bad in (2.5, "2", True, np.inf, 1e300 + 0.5j, np.array([2, 2.5], dtype=object)):
         with pytest.raises(ValueError):
             alg.pown(Interval(1, 2), bad)
 

@@ -463,6 +463,51 @@ def test_float_integer_exponent_keeps_negative_solutions():
     assert mp_in(-2, float(r.lo[0]), float(r.hi[0]))
 
 
+@pytest.mark.parametrize("n", [1e20, 2.0**64, 1e300])
+def test_huge_integer_exponent_keeps_negative_solutions(n):
+    """Issue 27 item 7: x**n for an integer-valued float n beyond 2**63 is an (even) integer
+    power, forward and backward, in the Python contractor and in the compiled engine (whose
+    int64 conversion of the tape's exponent was undefined there: 1e20 became -2**63)."""
+    # |x|**n >= 2 holds for |x| > 1 (2**(1/n) - 1 is below one ulp of 1), fails for |x| <= 1
+    for ctc in (CtcFwdBwd([x**n >= 2], ["x"]),):
+        r = ctc(Interval([-3], [0.5]))
+        assert float(r.lo[0]) == -3.0 and -1.0 - 2**-52 <= float(r.hi[0]) < -1.0 + 2**-52, r
+    res = propagate([x**n >= 2], domains={"x": Interval(-3, 0.5)}, mode="hc4")
+    assert res.consistent and float(res["x"].lo) == -3.0, res["x"]
+    assert -1.0 - 2**-52 <= float(res["x"].hi) < -1.0 + 2**-52, res["x"]
+    # |x|**n <= 1: exactly |x| <= 1 (the bounds may keep one ulp more)
+    res = propagate([x**n <= 1], domains={"x": Interval(-3, 3)}, mode="hc4")
+    assert res.consistent and -1.0 - 2**-51 <= float(res["x"].lo) <= -1.0, res["x"]
+    assert 1.0 <= float(res["x"].hi) <= 1.0 + 2**-51, res["x"]
+    # a negative exponent: |x|**-n <= 1 for |x| >= 1, x**-n > 0 everywhere
+    res = propagate([x ** (-n) >= 0.5, y == x ** (-n)],
+                    domains={"x": Interval(-3, -2), "y": Interval(-1, 1)}, mode="hc4")
+    assert not res.consistent  # x**-n in ]0, 5e-324] there: never >= 0.5
+    res = propagate([y == x ** (-n)], domains={"x": Interval(-3, -2), "y": Interval(-1, 1)},
+                    mode="hc4")
+    assert res.consistent and float(res["y"].lo) == 0.0 and float(res["y"].hi) == 2.0**-1074
+
+
+def test_revise_pown_with_huge_tape_exponents():
+    """The compiled image and reverse step of a pown node (``revise``, their composition) take
+    the tape's float64 exponent of any magnitude (an integer-valued float, hence even beyond
+    2**53) as the integer power: ``np.int64(p)`` is undefined beyond 2**63."""
+    from boundest.ctc.revise import POWN, revise
+
+    buf = np.empty(4)
+    # x in [-3, -2]: x**n >= 2**n > MAX for n >= 2**62, and 0 < x**n <= 2**n < 2**-1074 for
+    # n <= -2**62 (n even)
+    for p, (zl, zh) in ((1e20, (MAX, INF)), (2.0**64, (MAX, INF)), (-1e300, (0.0, 2.0**-1074)),
+                        (2.0**62, (MAX, INF)), (-(2.0**63), (0.0, 2.0**-1074))):
+        got = revise(POWN, -INF, INF, -3.0, -2.0, 0.0, 0.0, p, buf, None, True, None, None)
+        assert got[:4] == (zl, zh, -3.0, -2.0), (p, got)
+    # backward: x**1e20 in [0, 1] keeps exactly [-1, 1] (to an ulp)
+    z0, z1, x0, x1 = revise(POWN, 0.0, 1.0, -3.0, 3.0, 0.0, 0.0, 1e20, buf, None, True, None,
+                            None)[:4]
+    assert (z0, z1) == (0.0, 1.0)
+    assert -1.0 - 2**-52 <= x0 <= -1.0 and 1.0 <= x1 <= 1.0 + 2**-52
+
+
 # -------------------------------------------------------------------------------------------
 # 5. composition
 # -------------------------------------------------------------------------------------------

@@ -700,6 +700,23 @@ def test_atan2_branch_cut_regression():
     assert bool(ok)
 
 
+@pytest.mark.parametrize("n", [2.0**62, 1e20, 2.0**64, -1e20, 1e300])
+@pytest.mark.parametrize("a", [1.0, -1.0, 0.5, -0.5, 1 - 2**-53, -(1 + 2**-52), -3.0, 3.0])
+def test_huge_integer_exponent_derivative(n, a):
+    """d/dx x**n = n x**(n - 1) for an integer-valued float n beyond 2**62 (issue 27 item 7):
+    the factor n is exact (not the int64 the kernels take beyond 2**63), the power has the
+    parity of n - 1 (odd): at x = 1 the slope is exactly n, at x = -1 exactly -n."""
+    _, J = jacobian(Var("x") ** n, Interval([a], [a]))
+    lo, hi = float(J.lo[0, 0]), float(J.hi[0, 0])
+    with mpmath.workprec(300):
+        p = mpmath.iv.mpf(abs(a)) ** (int(n) - 1)  # rigorous enclosure of |a|**(n-1)
+        d = p * int(n)
+        dl, dh = (-d.b, -d.a) if a < 0 else (d.a, d.b)  # n - 1 is odd
+    assert (lo == -INF or mpf(lo) <= dl) and (hi == INF or dh <= mpf(hi)), (n, a, lo, hi)
+    if abs(a) == 1.0:
+        assert lo == hi == n * a
+
+
 @pytest.mark.parametrize(("name", "box", "ok"), [
     ("sqrt", [(0.0, 1.0)], True), ("sqrt", [(-1e-300, 1.0)], False),
     ("log", [(1e-300, 1.0)], True), ("log", [(0.0, 1.0)], False),

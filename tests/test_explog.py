@@ -463,6 +463,75 @@ def test_pow_integer_exponent_goes_to_pown():
     assert same(z, 2.0, 2.0)
 
 
+ETA = 2.0**-1074
+
+
+def test_pow_integer_float_exponent_beyond_2_63_keeps_negative_bases():
+    """Issue 27 item 7: an integer-valued float exponent beyond 2**63 is still an integer, so
+    the integer power: (-3..-2)**1e20 is a real number beyond MAX, not the empty set."""
+    import boundest as bd
+
+    x = Interval(-3, -2)
+    assert same(bd.pow(x, 1e20), MAX, INF)
+    assert same(bd.pow(x, 2.0**64), MAX, INF)
+    assert same(x**1e300, MAX, INF)
+    assert same(x**-1e300, 0.0, ETA)  # positive, below the smallest subnormal
+    assert same(ex.pow(x, np.float64(2.0**63)), MAX, INF)
+    assert same(x ** (2**64 + 1), -INF, -MAX)  # a Python int of any size, odd: negative
+    assert same(Interval(-1, -1) ** 1e300, 1.0, 1.0)
+
+
+#: Integer-valued floats from 2**52 (spacing 1) to 1e300, and their negatives.
+_INT_FLOATS = st.one_of(st.floats(2.0**52, 1e300), st.sampled_from([2.0**62, 2.0**63, 2.0**64]))
+
+
+@settings(max_examples=200, deadline=None)
+@given(data=st.data())
+def test_pow_and_operator_with_huge_integer_floats_enclose_the_exact_power(data):
+    """Negative, positive and zero-containing bases: ``pow``, ``**`` and the operator with a
+    degenerate ``Interval`` exponent are ``pown``, and contain the exact power (its sign from
+    the parity, its magnitude possibly beyond the float range)."""
+    import boundest as bd
+    from boundest.interval import algebraic as alg
+
+    x = data.draw(intervals())
+    a = data.draw(point_in(x))
+    n = data.draw(_INT_FLOATS) * data.draw(st.sampled_from([1.0, -1.0]))
+    assume(not (n < 0 and a == 0.0))
+    want = alg.pown(x, n)
+    with mpmath.workprec(300):
+        v = mpmath.iv.mpf(abs(a)) ** int(n)  # a rigorous enclosure of |a|**n
+    lo, hi = (-v.b, -v.a) if a < 0 and int(n) % 2 else (v.a, v.b)  # odd below 2**53 only
+    for r in (ex.pow(x, n), bd.pow(x, n), x**n, x ** Interval(n)):
+        assert valid(r) and same(r, float(want.lo), float(want.hi)), (x, n, r, want)
+        assert mp(float(r.lo)) <= lo and hi <= mp(float(r.hi)), (x, a, n, r)
+
+
+@pytest.mark.parametrize("n", [2, 3, 5, -1, -2, 0, 2**40 + 1, 2.0**64])
+def test_operator_takes_a_degenerate_integer_interval_exponent_as_pown(n):
+    """One rule with expressions: ``x ** Interval(n)`` is the integer power for an integer
+    ``n`` (negative bases kept), while the named ``pow`` with an ``Interval`` exponent stays
+    IEEE 1788 ``pow`` (its conformance vectors: ``pow([-0.1, 0.5], [1, 1]) = [0, 0.5]``)."""
+    import boundest as bd
+    from boundest.interval import algebraic as alg
+
+    for x in (Interval(-3, -2), Interval(-2, 1.5), Interval(0.5, 3)):
+        want = alg.pown(x, n)
+        assert same(x ** Interval(n), float(want.lo), float(want.hi)), (x, n)
+        assert same(ex.power(x, Interval(n)), float(want.lo), float(want.hi))
+        real = ex.pow(x, Interval(n))
+        got = bd.pow(x, Interval(n))
+        assert np.array_equal([got.lo, got.hi], [real.lo, real.hi], equal_nan=True)
+        if float(x.hi) < 0:  # 1788 pow is defined for x >= 0 only
+            assert is_empty(real)
+    assert is_empty(bd.pow(Interval(-3, -2), Interval(2)))
+    assert same(bd.pow(Interval(-0.1, 0.5), Interval(1)), 0.0, 0.5)
+    assert same(Interval(-0.1, 0.5) ** Interval(1), -0.1, 0.5)
+    # a non-integer or non-degenerate interval exponent is the real power with either spelling
+    assert is_empty(Interval(-3, -2) ** Interval(2.5))
+    assert is_empty(Interval(-3, -2) ** Interval(2, 3))
+
+
 # -------------------------------------------------------------------------------------------
 # reverse, unary
 # -------------------------------------------------------------------------------------------

@@ -30,8 +30,10 @@ from boundest.expr import (
     parse_model,
     variables,
 )
-from boundest.expr.nodes import BINARY, UNARY
+from boundest.expr.nodes import BINARY, UNARY, integer_exponent
 from boundest.expr.tape import OPS, compile_model
+
+from .strategies import intervals
 
 decimal_interval = Interval.from_decimal  # the public entry of boundest.interval.decimal
 
@@ -470,11 +472,11 @@ def test_truncated_input_is_still_one_syntax_error_on_the_right_line():
 
 @pytest.mark.parametrize(("text", "line", "col"), [
     ("x in [0,1];\nConstraints\nx = x^1e300;", 3, 5),
-    ("x in [0,1];\nConstraints\nx =\n  pow(x, 1e22);", 4, 3),
+    ("x in [0,1];\nConstraints\nx =\n  pow(x, 1e23);", 4, 3),
 ])
 def test_too_large_integer_exponent_error_has_position(text, line, col):
-    # 1e300 and 1e22 are integers beyond 2**53: neither pown (tape exponents are float64) nor
-    # pow (which would drop the negative bases)
+    # the decimals 1e300 and 1e23 are integers beyond 2**53 that no float equals: neither pown
+    # (tape exponents are float64; 1e22 is one) nor pow (which would drop the negative bases)
     with pytest.raises(ModelSyntaxError, match=rf"^model.txt:{line}:{col}: integer exponent"):
         parse_model(text, "model.txt")
 
@@ -839,20 +841,90 @@ def test_both_front_ends_agree_on_powers(text, value, node):
         assert all(shape(e)[:2] == node for e in py)
 
 
-def test_integer_exponent_beyond_2_53_is_refused():
+def test_integer_exponent_beyond_2_53_must_be_a_float():
+    """Issue 27 item 7: every integer-valued exponent is the integer power, however large, as
+    long as the tape's float64 holds it exactly (every float does: 1e300 is an integer)."""
     import boundest as bd
+    from boundest.expr import functions
 
-    for n in (2**53 + 2, 1e300, -(2**60)):
+    for n in (2**53 + 2, 1e20, 1e300, -1e300, -(2**60), 2.0**64, 2**64, 10**22, np.int64(2**62),
+              np.float64(2.0**63), Interval(1e20), Const(-(2.0**64))):
+        k = integer_exponent(n)
+        assert k is not None and k == float(n.value.lo if isinstance(n, Const) else
+                                            n.lo if isinstance(n, Interval) else n)
+        for e in (x**n, bd.pow(x, n) if not isinstance(n, Interval) else x**n,
+                  functions.pown(x, n)):
+            assert e.name == "pown" and e.param == k and type(e.param) is int, (n, e)
+    for n in (2**53 + 1, -(2**60 + 1), 10**23, 2**63 + 1, np.uint64(2**63 + 1), 10**400):
+        assert integer_exponent(n) is None
         with pytest.raises(ValueError, match="integer exponent"):
             _ = x**n
         with pytest.raises(ValueError, match="integer exponent"):
             bd.pow(x, n)
+        with pytest.raises(ValueError, match="integer exponent"):
+            Op("pown", (x,), n)
     assert (x ** 2**53).param == 2**53
     with pytest.raises(TypeError, match="boolean"):
         _ = x**True
     with pytest.raises(ValueError, match="pown needs an integer"):
-        from boundest.expr import functions
         functions.pown(x, 2.5)
+
+
+def test_huge_integer_exponents_in_the_text_format():
+    m = parse_model("x in [-3, -2], z in [-oo, +oo]; Constraints z = x^1e20, z = pow(x, 1e22),"
+                    " z = x^-18446744073709551616, z = x^(-2e22);")
+    got = [(c.rhs.name, c.rhs.param) for c in m.constraints]
+    assert got == [("pown", 10**20), ("pown", 10**22), ("pown", -(2**64)), ("pown", -2 * 10**22)]
+    # the decimal 1e300 is no float (an error), the float 1e300 is: its display reads back
+    e = x**-1e300
+    again = parse_model(f"x in [-3, -2], z in [-oo, +oo]; Constraints z = {e};")
+    assert again.constraints[0].rhs.param == e.param == -int(1e300)
+
+
+#: Integer-valued floats from 2**52 (spacing 1) to 1e300, both signs.
+HUGE_FLOATS = st.builds(lambda f, s: f * s, st.one_of(
+    st.floats(2.0**52, 1e300), st.sampled_from([2.0**62, 2.0**63, 2.0**64, 1e20, 1e300])),
+    st.sampled_from([1.0, -1.0]))
+
+
+def _same_iv(a: Interval, b: Interval) -> bool:
+    return (np.array_equal(np.ravel(a.lo), np.ravel(b.lo), equal_nan=True)
+            and np.array_equal(np.ravel(b.hi), np.ravel(a.hi), equal_nan=True))
+
+
+@settings(max_examples=150, deadline=None)
+@given(box=intervals(), n=HUGE_FLOATS)
+def test_both_front_ends_agree_on_huge_powers(box, n):
+    """An expression compiled and evaluated on a box (the tape's kernels) gives the powers of
+    the interval front end, for negative, positive and zero-containing boxes."""
+    import boundest as bd
+    from boundest.ctc.derivatives import evaluate
+
+    b1 = Interval([float(box.lo)], [float(box.hi)])
+    for e, want in ((x**n, box**n), (bd.pow(x, n), bd.pow(box, n)),
+                    (x ** Interval(n), box ** Interval(n))):
+        assert e.name == "pown"
+        assert _same_iv(evaluate(e, b1), want), (e, box, n)
+
+
+@pytest.mark.parametrize("n", [-3, -2, -1, 0, 1, 2, 3, 5, 2.0**64])
+@pytest.mark.parametrize("box", [(-3.0, -2.0), (-2.0, 1.5), (0.5, 3.0), (0.0, 0.0)])
+def test_both_front_ends_agree_on_degenerate_interval_exponents(n, box):
+    """``X ** Interval(n)`` is the integer power on intervals as on expressions (it was the real
+    power on intervals: empty for negative bases); ``pow(X, Interval(n))`` is IEEE 1788 ``pow``
+    on both (its conformance vectors)."""
+    import boundest as bd
+    from boundest.ctc.derivatives import evaluate
+
+    X = Interval(*box)
+    b1 = Interval([box[0]], [box[1]])
+    op, named = x ** Interval(n), bd.pow(x, Interval(n))
+    assert op.name in ("sqr", "pown") and named.name == "pow"
+    assert _same_iv(evaluate(op, b1), X ** Interval(n)), (n, box)
+    assert _same_iv(X ** Interval(n), bd.pown(X, n))
+    assert _same_iv(evaluate(named, b1), bd.pow(X, Interval(n))), (n, box)
+    if box[1] < 0:
+        assert bool(bd.pow(X, Interval(n)).is_empty()) and not bool((X ** Interval(n)).is_empty())
 
 
 # -------------------------------------------------------------------------------------------

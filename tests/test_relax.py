@@ -28,7 +28,7 @@ from boundest.ctc.linear import extract, lp_bound
 from boundest.ctc.relax import relaxation
 from boundest.expr import Model, Op, Var
 from boundest.expr import functions as fn
-from boundest.expr.tape import compile_model
+from boundest.expr.tape import OPS, compile_model
 from boundest.interval import Interval
 
 from .exact_lp import exact_min
@@ -144,6 +144,29 @@ def test_unary_rows_hold_on_the_graph(name, data):
             continue
         v = exact(M(p))
         if not mpmath.isfinite(v):  # log(0): not a point of the graph
+            continue
+        _check_rows(tape, lo, hi, {sx: M(p), sz: v})
+
+
+@pytest.mark.parametrize("n", [2.0**53 + 2, 2.0**62, 1e20, 2.0**64, -(2.0**64), 1e300])
+@pytest.mark.parametrize("box", [(1 - 2**-44, 1 + 2**-44), (-1 - 2**-44, -1 + 2**-44),
+                                 (0.5, 1.0), (-1.0, 1.0), (-3.0, 1.0), (1.0, 2.0)])
+def test_huge_pown_rows_hold_on_the_graph(n, box):
+    """Issue 27 item 7: rows of ``z = x**n`` for an integer-valued float n beyond 2**53 (even)
+    hold at the points of the graph within the float range (the kernels take n beyond 2**63
+    as an int64 of its parity; the tangents' slope factor is the exact n)."""
+    xl, xh = box
+    if n < 0 and xl <= 0 <= xh:
+        return
+    tape, lo, hi = _tape_box(z == x**n, {"x": (xl, xh)})
+    assert tape.param[[OPS[c] for c in tape.op].index("pown")] == n
+    sx, sz = tape.slot_of["x"], tape.slot_of["z"]
+    pts = [xl, xh, 0.5 * xl + 0.5 * xh, 1.0, -1.0, 1 - 2**-53, 1 - 2**-52, 1 + 2**-52]
+    for p in pts:
+        if not xl <= p <= xh:
+            continue
+        v = M(p) ** int(n)
+        if v != 0 and not M(2) ** -1000 < abs(v) < M(2) ** 1000:  # not a float-range point
             continue
         _check_rows(tape, lo, hi, {sx: M(p), sz: v})
 

@@ -144,8 +144,8 @@ def _slopes_other(code, zl, zh, xl, xh, yl, yh, p, buf):
     if code == TANH:
         dl, dh = _one_minus_sqr(zl, zh)
         return dl, dh, 0.0, 0.0
-    if code == POWN:
-        n = np.int64(p)
+    if code == POWN:  # p x**(p - 1): p exact (a float64), x**(p - 1) by the int64 exponent
+        n = al._tape_exponent(p)
         if n == 0:
             return 0.0, 0.0, 0.0, 0.0
         if n == 1:

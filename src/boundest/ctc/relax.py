@@ -86,6 +86,7 @@ from ..interval import (
     tan,
     tanh,
 )
+from ..interval.algebraic import _exponent
 from ..interval.algebraic import abs as iabs
 from .linear import CtcLinear
 
@@ -264,8 +265,10 @@ def _unary_rows(tape: Tape, lo: NDArray, hi: NDArray, keep: NDArray) -> list[Row
         sdef = (xl > 0) | (xh < 0)
         curv = np.where(n > 0, np.where(even, 1, sgn),
                         np.where(sdef, np.where(even | (xl > 0), 1, -1), 0))
-        k = n[m].astype(np.int64)
-        add(m, curv, lambda p: pown(p, k), lambda p: _pt(k.astype(np.float64)) * pown(p, k - 1))
+        # the kernels' int64 exponents (any magnitude: not astype, undefined beyond 2**63);
+        # the factor of the derivative is the exact n itself
+        k = _exponent(n[m])
+        add(m, curv, lambda p: pown(p, k), lambda p: _pt(n[m]) * pown(p, k - 1))
     return rows
 
 

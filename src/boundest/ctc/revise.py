@@ -49,7 +49,9 @@ _f_tanh, _f_atan, _f_asin, _f_acos = (el._tanh.bounds, el._atan.bounds, tr._asin
                                       tr._acos.bounds)
 _f_atan2, _f_pow = el._atan2.scalar, el._pow.scalar
 _f_sin, _f_cos, _f_tan = tr._sin.scalar, tr._cos.scalar, tr._tan.bounds
-_f_pown, _b_pown = al._pown.scalar, al._pown_rev.scalar
+# a tape's pown exponent (a float64 of any magnitude) as the kernels' int64: not np.int64(p),
+# undefined beyond 2**63 (1e20 became -2**63, an odd negative power)
+_f_pown, _b_pown, _pown_n = al._pown.scalar, al._pown_rev.scalar, al._tape_exponent
 _b_exp, _b_log, _b_sinh, _b_cosh = (el._exp_rev.scalar, el._log_rev.scalar, el._sinh_rev.scalar,
                                     el._cosh_rev.scalar)
 _b_tanh, _b_atan, _b_atan2, _b_pow = (el._tanh_rev.scalar, el._atan_rev.scalar,
@@ -178,7 +180,7 @@ def image(code, xl, xh, yl, yh, p, buf, piecewise, pown, explog, trig):
     if code == NEG:
         return -xh, -xl
     if pown is not None and code == POWN:
-        _f_pown(xl, xh, np.int64(p), buf[0:1], buf[1:2])
+        _f_pown(xl, xh, _pown_n(p), buf[0:1], buf[1:2])
         return buf[0], buf[1]
     if piecewise is not None and code in (ABS, SIGN, FLOOR, CEIL, MIN, MAX):
         if code == MIN:
@@ -279,7 +281,7 @@ def back(code, zl, zh, xl, xh, yl, yh, p, buf, piecewise, pown, explog, trig):
     elif code == NEG:
         xl, xh = al._neg_rev_all(zl, zh, xl, xh)
     elif pown is not None and code == POWN:
-        _b_pown(zl, zh, xl, xh, np.int64(p), buf[0:1], buf[1:2])
+        _b_pown(zl, zh, xl, xh, _pown_n(p), buf[0:1], buf[1:2])
         xl, xh = buf[0], buf[1]
     elif piecewise is not None and code in (ABS, SIGN, FLOOR, CEIL, MIN, MAX):
         return _back_piecewise(code, zl, zh, xl, xh, yl, yh)

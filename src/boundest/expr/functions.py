@@ -45,7 +45,7 @@ def _binary(name: str) -> Callable[[Any, Any], Any]:
     def func(x: Any, y: Any) -> Any:
         if isinstance(x, Expr) or isinstance(y, Expr):
             if name == "pow":
-                return power(x, y)  # an integer constant exponent is the integer power
+                return power(x, y, named=True)  # an integer constant: the integer power
             return Op(name, (as_expr(x), as_expr(y)))
         return f(x, y)
 
@@ -53,9 +53,11 @@ def _binary(name: str) -> Callable[[Any, Any], Any]:
     func.__doc__ = f"``{name}(x, y)``: interval enclosure, or an expression node."
     if name == "pow":
         func.__doc__ = ("``pow(x, y)``: interval enclosure, or an expression node. An integer "
-                        "constant ``y`` (``2``, ``2.0``, ``-3``) is the integer power (any sign "
-                        "of ``x``), any other ``y`` the real power (``x >= 0``); see "
-                        "``boundest.expr.nodes.power``.")
+                        "number ``y`` (``2``, ``2.0``, ``-3``, ``1e20``: any magnitude) is the "
+                        "integer power (any sign of ``x``), any other ``y`` the real power "
+                        "(``x >= 0``), an ``Interval`` ``y`` too (IEEE 1788 ``pow``, also when "
+                        "degenerate: ``x ** Interval(2)`` is the integer power); the same on "
+                        "intervals and on expressions, see ``boundest.expr.nodes.power``.")
     return func
 
 
@@ -64,7 +66,8 @@ def pown(x: Any, n: int) -> Any:
     if isinstance(x, Expr):
         k = integer_exponent(n)
         if k is None:
-            raise ValueError(f"pown needs an integer exponent of magnitude <= 2**53, got {n!r}")
+            raise ValueError(f"pown needs an integer exponent (a float64 value beyond 2**53), "
+                             f"got {n!r}")
         return power(x, k)
     return iv.pown(x, n)
 

@@ -13,10 +13,14 @@ independently at each occurrence, as interval evaluation does; the compiler neve
 occurrences, unless ``Const.exact`` says they denote the same real number (a decimal literal
 of the model text format).
 
-Powers: an integer constant exponent (``2``, ``2.0``, ``-3``, ``Const(3)``) is the integer power
-``pown`` (``sqr`` for 2), defined for every sign of the base; any other exponent is the real
-power ``pow``, defined for a base ``>= 0``. ``x ** n``, ``boundest.pow(x, n)`` and the text
-format's ``x^n`` and ``pow(x, n)`` all follow this rule (``power``).
+Powers: an integer constant exponent (``2``, ``2.0``, ``-3``, ``1e20``, ``Const(3)``) is the
+integer power ``pown`` (``sqr`` for 2), defined for every sign of the base; any other exponent is
+the real power ``pow``, defined for a base ``>= 0``. ``x ** n``, ``boundest.pow(x, n)`` and the
+text format's ``x^n`` and ``pow(x, n)`` all follow this rule (``power``), as intervals do
+(``boundest.interval.explog.power``): the one difference between the operator and the named
+function is an ``Interval`` exponent, which ``boundest.pow`` always takes as the IEEE 1788 real
+power (``pow(x, Interval(2))`` is defined for ``x >= 0`` only) and ``**`` as the integer power
+when it is a degenerate integer.
 """
 
 from __future__ import annotations
@@ -50,7 +54,9 @@ UNARY = ("neg", "sqr", "sqrt", "exp", "log", "sin", "cos", "tan", "asin", "acos"
 #: Binary primitives.
 BINARY = ("add", "sub", "mul", "div", "pow", "atan2", "min", "max")
 _INFIX = {"add": ("+", 1), "sub": ("-", 1), "mul": ("*", 2), "div": ("/", 2)}
-#: Largest ``|n|`` of an integer exponent: the tape keeps exponents as float64, exact to 2**53.
+#: Beyond this ``|n|`` an integer exponent must be a float64 value (every integer-valued float
+#: is, ``1e300`` too): the tape keeps exponents as float64, and an integer such as
+#: ``2**53 + 1`` would be rounded to another one (an odd power to an even one).
 MAX_POWN_EXPONENT = 2**53
 
 
@@ -238,6 +244,9 @@ class Op(Expr):
         if name == "pown" and not (isinstance(param, numbers.Integral)
                                    and not isinstance(param, bool)):
             raise ValueError(f"pown needs an integer exponent, got {param!r}")
+        if name == "pown" and not _tape_exact(int(param)):  # type: ignore[arg-type]
+            raise ValueError(f"integer exponent {param} is not a float64 value: beyond "
+                             f"2**53 an expression's integer exponent must be one")
         self.name, self.args, self.param = name, args, param
 
     def __str__(self) -> str:
@@ -376,12 +385,23 @@ def as_expr(x: object) -> Expr:
     raise TypeError(f"cannot use {type(x).__name__} {x!r} in an expression")
 
 
+def _tape_exact(n: int) -> bool:
+    """Whether the integer ``n`` is a float64 value (a tape holds its exponent as one)."""
+    if -MAX_POWN_EXPONENT <= n <= MAX_POWN_EXPONENT:
+        return True
+    try:
+        return int(float(n)) == n
+    except OverflowError:
+        return False
+
+
 def integer_exponent(e: object) -> int | None:
     """The integer ``n`` when ``e`` is an integer constant exponent, else None.
 
-    Integer constants are Python/NumPy integers, integer-valued floats (``2.0``), and
-    degenerate constants (``Const``, ``Interval``) with an integer value, of magnitude at most
-    ``MAX_POWN_EXPONENT``; booleans are not numbers here.
+    Integer constants are Python/NumPy integers, integer-valued floats (``2.0``, ``1e20``: every
+    float beyond ``2**53`` is an integer), and degenerate constants (``Const``, ``Interval``)
+    with an integer value; beyond ``MAX_POWN_EXPONENT`` an integer must be a float64 value
+    (``2**64`` is, ``2**53 + 1`` is not). Booleans are not numbers here.
     """
     if isinstance(e, bool):
         return None
@@ -402,40 +422,54 @@ def integer_exponent(e: object) -> int | None:
         n = int(lo)
     else:
         return None
-    return n if -MAX_POWN_EXPONENT <= n <= MAX_POWN_EXPONENT else None
+    return n if _tape_exact(n) else None
 
 
-def power(base: object, exponent: object) -> Expr:
-    """``base ** exponent`` as an expression, the one power rule of both front ends.
+def power(base: object, exponent: object, named: bool = False) -> Expr:
+    """``base ** exponent`` (or ``pow(base, exponent)`` when ``named``) as an expression, the
+    one power rule of both front ends.
 
-    An integer constant exponent (see ``integer_exponent``) gives the integer power: ``sqr`` for
-    2, else ``pown`` (any sign of the base; ``pown(x, -1) = 1/x``, ``pown(x, 0) = 1``). Any
-    other exponent (a non-integer, an interval, an expression) gives the real power ``pow``,
-    defined for ``base >= 0``.
+    An integer constant exponent (see ``integer_exponent``), of any magnitude, gives the integer
+    power: ``sqr`` for 2, else ``pown`` (any sign of the base; ``pown(x, -1) = 1/x``,
+    ``pown(x, 0) = 1``, ``x ** 1e20`` is even, ``[MAX, inf]`` for ``x in [-3, -2]``). Any other
+    exponent (a non-integer, an interval, an expression) gives the real power ``pow``, defined
+    for ``base >= 0``. The named function (``boundest.pow``) takes an ``Interval`` exponent as
+    IEEE 1788 ``pow`` even when it is a degenerate integer, as it does on intervals (the 1788
+    ``pow([-0.1, 0.5], [1, 1]) = [0, 0.5]``); ``x ** Interval(3)`` is ``pown(x, 3)`` on both
+    front ends.
+
+    Parameters
+    ----------
+    base, exponent : expression, number or Interval
+    named : bool
+        Whether this is the named function ``pow`` rather than the operator ``**``.
 
     Raises
     ------
     ValueError
-        For an integer-valued exponent beyond ``MAX_POWN_EXPONENT`` (not representable exactly
-        in a tape; ``pow`` would silently drop the negative bases).
+        For an integer exponent beyond ``MAX_POWN_EXPONENT`` that is not a float64 value (the
+        tape could not hold it exactly, and the real power would drop the negative bases): a
+        Python integer such as ``2**53 + 1``, a decimal literal such as ``1e23``.
     TypeError
         For a boolean exponent.
     """
     if isinstance(exponent, bool):
         raise TypeError("a boolean is not an exponent")
+    if named and isinstance(exponent, Interval):
+        return Op("pow", (as_expr(base), as_expr(exponent)))
     n = integer_exponent(exponent)
     if n is not None:
         b = as_expr(base)
         return Op("sqr", (b,)) if n == 2 else Op("pown", (b,), n)
+    if isinstance(exponent, numbers.Integral):
+        raise ValueError(f"integer exponent {int(exponent)} is not a float64 value: beyond "
+                         f"2**53 an expression's integer exponent must be one")
     e = as_expr(exponent)
-    if isinstance(e, Const):
-        lo, hi = float(e.value.lo), float(e.value.hi)
-        # an integer too large for a float64 exponent: a float, or a decimal such as 1e300
-        if (lo == hi and math.isfinite(lo) and lo.is_integer()) or (
-                e.exact is not None and e.exact[0] != 0 and e.exact[2] >= 0):
-            shown = (f"{'-' if e.exact[0] < 0 else ''}{e.exact[1][:20]}e{e.exact[2]}"
-                     if e.exact is not None else f"{lo:g}")
-            raise ValueError(f"integer exponent {shown} too large: |n| must be at most 2**53")
+    if isinstance(e, Const) and e.exact is not None and e.exact[0] != 0 and e.exact[2] >= 0:
+        # a decimal integer that no float equals (1e23): its enclosure is not degenerate
+        shown = f"{'-' if e.exact[0] < 0 else ''}{e.exact[1][:20]}e{e.exact[2]}"
+        raise ValueError(f"integer exponent {shown} is not a float64 value: beyond 2**53 an "
+                         f"expression's integer exponent must be one")
     return Op("pow", (as_expr(base), e))
 
 

@@ -22,8 +22,9 @@ such as ``0.1`` denotes the exact decimal and becomes the tightest float interva
 decimal are one number, two different decimals are never merged.
 Functions: sqrt exp log sin cos tan asin acos atan sinh cosh tanh abs sign floor ceil (one
 argument), atan2 min max pow (two). ``x^n`` and ``pow(x, n)`` mean the same: with an integer
-constant ``n`` (``2``, ``2.0``, ``-3``, ``(-3)``) the integer power (``sqr`` for 2, else
-``pown``; any sign of x), with any other exponent the real power ``pow`` (defined for x >= 0).
+constant ``n`` (``2``, ``2.0``, ``-3``, ``(-3)``, ``1e20``) the integer power (``sqr`` for 2,
+else ``pown``; any sign of x), with any other exponent the real power ``pow`` (defined for
+x >= 0). An integer literal beyond ``2**53`` must be a float64 value (``1e20``, not ``1e23``).
 """
 
 from __future__ import annotations

@@ -90,8 +90,18 @@ _DW_DELTA = 16.0 * 2.0**-106
 _SAFE = 1.0 + 2.0**-40
 #: Beyond this (in binary orders of magnitude) a power certainly over- or underflows.
 _LOG2_LIMIT = 1100.0
-#: Largest accepted |n| for pown (the exponent is handled as an int64).
-_N_LIMIT = 2**62
+#: The kernels take the exponent of pown as an int64 ``n`` with ``|n| < 2**63``; an integer
+#: exponent ``N`` beyond that range stands for ``sign(N) * (_N_HUGE + N % 2)``, an int64 of the
+#: same sign and parity. The two have the same power at every float base: for ``|n| >= 7e18``
+#: (``_N_HUGE`` and ``_N_HUGE - 1``, the exponent of a derivative, among them) and a float
+#: ``a > 0`` other than 1, ``|n log2 a| >= 7e18 * 2**-53 / ln 2 > 1100`` (``1 - 2**-53`` is the
+#: float ``!= 1`` nearest to 1 in log; at ``_N_HUGE`` the product exceeds 1400), so ``a**n`` and
+#: ``a**N`` both lie beyond ``2**1100`` or both below ``2**-1100`` (on the same side), and
+#: ``_pow_pos`` decides both alike (``_LOG2_LIMIT``): ``[MAX, inf]`` or ``[0, ETA]``. The
+#: bases 0, 1 and inf depend only on the sign, and a negative base only on the parity too; the
+#: roots of ``pown_rev`` are found by comparing such powers of float candidates. Every float
+#: beyond ``2**53`` is even, so a float exponent that large maps to ``+-_N_HUGE``.
+_N_HUGE = 2**63 - 2
 _TINY_SQR = 2.0**-480
 
 
@@ -274,7 +284,7 @@ def _dw_mul(ah, al, bh, bl):
 
 @_jit_call
 def _pow_pos(a, n):
-    """``(lo, hi)`` enclosing ``a**n`` for finite ``a > 0`` and an integer ``0 < |n| < 2**62``."""
+    """``(lo, hi)`` enclosing ``a**n`` for finite ``a > 0`` and an integer ``0 < |n| < 2**63``."""
     if n == 1:
         return a, a
     if n == 2 and a >= _TINY_SQR:
@@ -1122,31 +1132,64 @@ def _rev2(kernel, z: IntervalLike, x: IntervalLike, y: IntervalLike,
     return out
 
 
+def _int_exponent(n: int) -> int:
+    """The kernels' exponent for a Python integer ``n`` (see ``_N_HUGE``): ``n`` itself when
+    ``|n| < 2**63``, else ``+-(_N_HUGE + n % 2)`` (the same sign and parity)."""
+    if -(2**63) < n < 2**63:
+        return n
+    k = _N_HUGE + (n & 1)
+    return k if n > 0 else -k
+
+
+def _scalar_exponent(v: object, n: object) -> int:
+    """One element of an object array of exponents (Python integers beyond int64 among them)."""
+    if isinstance(v, (int, np.integer)) and not isinstance(v, (bool, np.bool_)):
+        return _int_exponent(int(v))
+    if isinstance(v, (float, np.floating)) and math.isfinite(v) and float(v).is_integer():
+        return _int_exponent(int(v))
+    raise ValueError(f"pown exponent must be an integer, got {n!r}")
+
+
+@_jit
+def _tape_exponent(p):
+    """The kernels' int64 exponent for an integer-valued float64 ``p`` (a tape's exponent):
+    ``p`` itself when ``|p| < 2**63``, else ``+-_N_HUGE`` (a float that large is even)."""
+    if p >= 9223372036854775808.0:
+        return np.int64(_N_HUGE)
+    if p <= -9223372036854775808.0:
+        return np.int64(-_N_HUGE)
+    return np.int64(p)
+
+
 def _exponent(n: ArrayLike) -> np.ndarray:
-    """The integer exponent(s) ``n`` as int64, refusing non-integers and |n| >= 2**62."""
+    """The integer exponent(s) ``n`` as int64 for the kernels, refusing non-integers.
+
+    Every integer is accepted, of any magnitude (a Python int, a NumPy integer, an
+    integer-valued float); one beyond int64 becomes an int64 of the same sign and parity whose
+    power is enclosed alike at every float base (``_N_HUGE``).
+    """
+    if isinstance(n, int) and not isinstance(n, bool):
+        return np.asarray(_int_exponent(n), dtype=np.int64)
     arr = np.asarray(n)
+    if arr.dtype == np.object_:
+        out = np.empty(arr.shape, dtype=np.int64)
+        for i, v in np.ndenumerate(arr):
+            out[i] = _scalar_exponent(v, n)
+        return out
     if arr.dtype == np.bool_ or arr.dtype.kind not in "iuf":
         raise ValueError(f"pown exponent must be an integer, got {n!r}")
     if arr.dtype.kind == "f":
         if not np.all(np.isfinite(arr) & (arr == np.round(arr))):
             raise ValueError(f"pown exponent must be an integer, got {n!r}")
-        if np.any(np.abs(arr) >= float(_N_LIMIT)):
-            raise ValueError(f"pown exponent must satisfy |n| < 2**62, got {n!r}")
-        return arr.astype(np.int64)
+        big = np.abs(arr) >= 2.0**63  # even (every float beyond 2**53 is)
+        k = np.where(big, 0.0, arr).astype(np.int64)
+        return np.where(big, np.where(arr > 0, _N_HUGE, -_N_HUGE), k).astype(np.int64)
     if arr.dtype.kind == "u":
-        if np.any(arr >= _N_LIMIT):
-            raise ValueError(f"pown exponent must satisfy |n| < 2**62, got {n!r}")
-        return arr.astype(np.int64)
+        big = arr >= np.uint64(2**63)
+        return np.where(big, _N_HUGE + (arr & 1).astype(np.int64),
+                        np.where(big, 0, arr).astype(np.int64)).astype(np.int64)
     arr = arr.astype(np.int64)
-    if np.any((arr >= _N_LIMIT) | (arr <= -_N_LIMIT)):
-        raise ValueError(f"pown exponent must satisfy |n| < 2**62, got {n!r}")
-    return arr
-
-
-def _exponent_checked(n: ArrayLike) -> np.ndarray:
-    if isinstance(n, int) and not isinstance(n, bool) and _babs(n) >= _N_LIMIT:
-        raise ValueError(f"pown exponent must satisfy |n| < 2**62, got {n!r}")
-    return _exponent(n)
+    return np.where(arr == np.iinfo(np.int64).min, -_N_HUGE, arr).astype(np.int64)
 
 
 def abs(x: IntervalLike, out: Interval | None = None) -> Interval:
@@ -1161,9 +1204,18 @@ def pown(x: IntervalLike, n: ArrayLike, out: Interval | None = None) -> Interval
     means ``1 / x**|n|`` over ``x != 0`` (``pown([-1, 1], -2) = [1, inf]``,
     ``pown([0, 0], -1)`` is empty). Even powers use the case analysis of ``sqr``, never
     ``x * x``. Bounds are the tightest floats but in rare hard-to-round cases (one ulp wider).
+
+    ``n`` may have any magnitude (an integer-valued float such as ``1e300`` is an even integer):
+    ``pown([-3, -2], 1e20) = [MAX, inf]``, ``pown([-3, -2], -(2**64 + 1)) = [-ETA, 0]`` (the
+    exact value, negative and below the smallest subnormal in magnitude, lies in it).
+
+    Raises
+    ------
+    ValueError
+        When ``n`` is not an integer (a non-integer or non-finite float, a boolean, a string).
     """
     x = as_interval(x)
-    k = _exponent_checked(n)
+    k = _exponent(n)
     if out is None:
         return Interval._new(*_pown(x.lo, x.hi, k))
     _pown(x.lo, x.hi, k, out.lo, out.hi)
@@ -1269,10 +1321,11 @@ def pown_rev(z: IntervalLike, x: IntervalLike, n: ArrayLike,
     """Contract ``x`` with ``z = pown(x, n)`` (IEEE 1788 pownRev, integer ``n``).
 
     ``pown_rev([1, 4], [-5, 5], 2) = [-2, 2]``; ``pown_rev([-8, 27], [-5, 5], 3) = [-2, 3]``;
-    ``n = 0`` keeps ``x`` when ``1 in z`` and empties it otherwise.
+    ``n = 0`` keeps ``x`` when ``1 in z`` and empties it otherwise. ``n`` may have any
+    magnitude, as in ``pown``.
     """
     z, x = as_interval(z), as_interval(x)
-    k = _exponent_checked(n)
+    k = _exponent(n)
     if out is None:
         return Interval._new(*_pown_rev(z.lo, z.hi, x.lo, x.hi, k))
     _pown_rev(z.lo, z.hi, x.lo, x.hi, k, out.lo, out.hi)

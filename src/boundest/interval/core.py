@@ -487,8 +487,13 @@ class Interval:
         return NotImplemented if _defers(other) else _arith.div(other, self)
 
     def __pow__(self, other: Any) -> Interval:
+        """``self ** other``: the integer power for an integer-valued exponent (an int, an
+        integer-valued float, a degenerate integer ``Interval``; any magnitude), else IEEE 1788
+        ``pow`` (see ``explog.power``)."""
+        if _defers(other):
+            return NotImplemented
         from . import explog
-        return explog.pow(self, other)
+        return explog.power(self, other)
 
     def __abs__(self) -> Interval:
         from . import algebraic

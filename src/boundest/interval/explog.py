@@ -1330,13 +1330,21 @@ def atan2(y: IntervalLike, x: IntervalLike, out: Interval | None = None) -> Inte
 
 
 def _integer_exponent(y: object) -> int | None:
-    """``int(y)`` for a plain integer (or integer-valued float) scalar, else None."""
+    """``int(y)`` for a plain integer (or integer-valued float) scalar, of any magnitude, else
+    None (``1e300`` is an integer: an even one, as every float beyond ``2**53``)."""
     if isinstance(y, (int, np.integer)):
         return int(y)
-    if (isinstance(y, (float, np.floating)) and math.isfinite(y) and float(y).is_integer()
-            and abs(y) <= 2.0**63):
+    if isinstance(y, (float, np.floating)) and math.isfinite(y) and float(y).is_integer():
         return int(y)
     return None
+
+
+def _degenerate_integer(y: Interval) -> int | None:
+    """``n`` when ``y`` is a scalar degenerate interval ``[n, n]`` with ``n`` an integer."""
+    if y.shape != ():
+        return None
+    lo, hi = float(y.lo), float(y.hi)
+    return int(lo) if lo == hi and math.isfinite(lo) and lo.is_integer() else None
 
 
 def pow(x: IntervalLike, y: IntervalLike, out: Interval | None = None) -> Interval:
@@ -1345,8 +1353,12 @@ def pow(x: IntervalLike, y: IntervalLike, out: Interval | None = None) -> Interv
     the domain).
 
     A plain integer exponent (a Python or NumPy integer, or an integer-valued float scalar such
-    as ``2.0``, not an ``Interval``) is handed to ``algebraic.pown``, which also accepts
-    negative bases: ``pow([-2, 1], 2) = [0, 4]`` but ``pow([-2, 1], Interval(2)) = [0, 1]``.
+    as ``2.0`` or ``1e20``, of any magnitude; not an ``Interval``) is handed to
+    ``algebraic.pown``, which also accepts negative bases: ``pow([-2, 1], 2) = [0, 4]`` but
+    ``pow([-2, 1], Interval(2)) = [0, 1]`` (an ``Interval`` exponent is always the 1788
+    ``pow``). The operator ``x ** y`` (``power``) differs only there: it takes a degenerate
+    integer ``Interval`` exponent as the integer power too. Expressions follow the same rule
+    (``boundest.expr.nodes.power``).
     """
     n = None if isinstance(y, Interval) else _integer_exponent(y)
     if n is not None:
@@ -1358,6 +1370,24 @@ def pow(x: IntervalLike, y: IntervalLike, out: Interval | None = None) -> Interv
         out.hi[...] = r.hi
         return out
     return _binary(_pow, x, y, out)
+
+
+def power(x: IntervalLike, y: IntervalLike) -> Interval:
+    """``x ** y``, the operator: the integer power ``pown`` (any sign of ``x``) for an
+    integer-valued exponent of any magnitude -- a Python or NumPy integer, an integer-valued
+    float scalar, or a scalar degenerate ``Interval`` ``[n, n]`` -- else IEEE 1788 ``pow``.
+
+    ``Interval(-3, -2) ** Interval(5, 5) = [-243, -32]`` while ``pow(Interval(-3, -2),
+    Interval(5, 5))`` is empty (1788 ``pow``, defined for ``x >= 0``). An expression's ``**``
+    follows the same rule, so a model function gives the same powers evaluated on intervals as
+    compiled from expressions.
+    """
+    if isinstance(y, Interval):
+        n = _degenerate_integer(y)
+        if n is not None:
+            from .algebraic import pown
+            return pown(x, n)
+    return pow(x, y)
 
 
 # -- reverse -----------------------------------------------------------------------------------
