@@ -42,15 +42,14 @@ def same(z: Interval, lo: float, hi: float) -> bool:
 
 
 def engine_forward(name: str, x: Interval) -> Interval:
-    """Images of the scalar intervals of ``x`` through the compiled engine's forward step: its
-    family's revise kernel with ``z`` entire, whose new ``z`` is then the image itself."""
+    """Images of the scalar intervals of ``x`` through the compiled engine's forward step
+    (``revise.image``, the explog and trig families compiled in)."""
     from boundest.ctc import revise as engine
 
     code = getattr(engine, name.upper())
-    revise = engine._revise_trig if code in engine.FAMILIES["trig"] else engine._revise_explog
     buf = np.empty(4)
     lo, hi = np.empty(x.lo.size), np.empty(x.lo.size)
     for i in range(x.lo.size):
-        lo[i], hi[i] = revise(code, -np.inf, np.inf, float(x.lo.flat[i]), float(x.hi.flat[i]),
-                              0.0, 0.0, buf)[:2]
+        lo[i], hi[i] = engine.image(code, float(x.lo.flat[i]), float(x.hi.flat[i]), 0.0, 0.0,
+                                    0.0, buf, None, None, True, True)
     return Interval.trusted(lo, hi)

@@ -20,8 +20,8 @@ from boundest.ctc import revise as engine
 from boundest.expr import parse_model
 res = propagate(parse_model("x in [0, 10], y in [0, 10]; Constraints x^3 + y = 2, x*y >= 0.5;"))
 print(res.consistent, float(res["x"].hi) < 1.26)
-for f in (engine._revise_piecewise, engine._revise_explog, engine._revise_trig,
-          engine._revise_pown):
+for f in (engine._back_piecewise, engine._image_explog, engine._back_explog,
+          engine._image_trig, engine._back_trig, engine._f_pown):
     print(f.__name__, len(f.signatures))
 """
 
@@ -34,8 +34,8 @@ def test_an_arithmetic_tape_compiles_no_transcendental_kernel(tmp_path):
     assert out.returncode == 0, out.stderr[-2000:]
     lines = out.stdout.split("\n")
     assert lines[0] == "True True"
-    assert lines[1:5] == ["_revise_piecewise 0", "_revise_explog 0", "_revise_trig 0",
-                          "_revise_pown 1"]
+    assert lines[1:7] == ["_back_piecewise 0", "_image_explog 0", "_back_explog 0",
+                          "_image_trig 0", "_back_trig 0", "_pown 1"]
 
 
 def test_the_families_cover_every_op_outside_the_basic_arithmetic():

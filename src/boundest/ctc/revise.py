@@ -87,36 +87,6 @@ def _cap(zl, zh, nl, nh):
 
 
 @nb.njit(cache=True, error_model="numpy")
-def _revise_piecewise(code, zl, zh, xl, xh, yl, yh):
-    """HC4-revise of the piecewise nodes (abs, sign, floor, ceil, min, max)."""
-    if code == MIN:
-        nl, nh = al._min_all(xl, xh, yl, yh)
-        zl, zh = _cap(zl, zh, nl, nh)
-        xl, xh, yl, yh = al._min_rev_all(zl, zh, xl, xh, yl, yh)
-    elif code == MAX:
-        nl, nh = al._max_all(xl, xh, yl, yh)
-        zl, zh = _cap(zl, zh, nl, nh)
-        xl, xh, yl, yh = al._max_rev_all(zl, zh, xl, xh, yl, yh)
-    elif code == ABS:
-        nl, nh = al._abs_all(xl, xh)
-        zl, zh = _cap(zl, zh, nl, nh)
-        xl, xh = al._abs_rev_all(zl, zh, xl, xh)
-    elif code == SIGN:
-        nl, nh = al._sign_all(xl, xh)
-        zl, zh = _cap(zl, zh, nl, nh)
-        xl, xh = al._sign_rev_all(zl, zh, xl, xh)
-    elif code == FLOOR:
-        nl, nh = al._floor_all(xl, xh)
-        zl, zh = _cap(zl, zh, nl, nh)
-        xl, xh = al._floor_rev_all(zl, zh, xl, xh)
-    elif code == CEIL:
-        nl, nh = al._ceil_all(xl, xh)
-        zl, zh = _cap(zl, zh, nl, nh)
-        xl, xh = al._ceil_rev_all(zl, zh, xl, xh)
-    return zl, zh, xl, xh, yl, yh
-
-
-@nb.njit(cache=True, error_model="numpy")
 def _image_explog(code, xl, xh, yl, yh, buf):
     """Forward image of an exponential-family node (exp, log, sinh, cosh, tanh, atan, atan2,
     and the real power ``pow(x, y) = exp(y log x)``)."""
