@@ -181,6 +181,29 @@ def test_jaulin2001_small_eps_is_announced(tmp_path, capsys, monkeypatch):
     assert "a large run: --eps 0.001: about 100 times the work of the default --eps 0.01" in err
 
 
+@pytest.mark.parametrize(("argv", "said"), [
+    (["--sweeps", "200"], "a long run: 1 mission(s), 200 smoothing round(s) per ping: about 3 min"),
+    (["--monte-carlo", "100000"], "a long run: 100,000 mission(s), 0 smoothing round(s) per "
+                                  "ping: about 35 min"),
+    (["--monte-carlo", "2000", "--sweeps", "2", "--workers", "2"],
+     "a long run: 2,000 mission(s) on 2 workers, 2 smoothing round(s) per ping: about 27 min"),
+])
+def test_a_long_pool_run_says_how_long_before_it_starts(argv, said, tmp_path, capsys, no_work):
+    """Runs whose memory is small but whose time is long (many rounds, many missions) are
+    announced with their estimated time before they start (the work itself is refused by
+    ``no_work``: the line comes from the checks)."""
+    with pytest.raises(AssertionError, match="the command ran"):
+        main(["run", "pool", *argv, "--out", str(tmp_path)])
+    err = capsys.readouterr().err
+    assert f"boundest: {said}" in err, err
+
+
+def test_a_short_pool_run_is_not_announced(tmp_path, capsys, no_work):
+    with pytest.raises(AssertionError, match="the command ran"):
+        main(["run", "pool", "--monte-carlo", "100", "--out", str(tmp_path)])
+    assert "long run" not in capsys.readouterr().err
+
+
 def test_check_size_refuses_beyond_the_memory_given():
     from boundest.commands.options import check_size, count, gib
 

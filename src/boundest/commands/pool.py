@@ -18,7 +18,7 @@ from pathlib import Path
 
 from . import save_figure, subplots, write_json
 from .figures import FigureWorker
-from .options import check_input, check_outputs, check_size, positive_float, whole
+from .options import announce, check_input, check_outputs, check_size, positive_float, whole
 
 #: ``boundest.scenarios.pool.DEFAULT_SLICES`` and ``pool_observer.MAX_SIDE``, spelt out here so
 #: that the checks import nothing numerical (``tests/test_bad_input.py`` checks that they agree)
@@ -111,6 +111,31 @@ def check(args: argparse.Namespace) -> None:
                + (f" in {slices} heading slices" if args.paving_heading is not None else ""),
                f"--m {args.m}" + (f" --heading-slices {slices}"
                                   if args.paving_heading is not None else ""))
+    announce_duration(1 if args.sweeps is None else args.sweeps)
+
+
+#: Seconds of work a run costs, measured on the development machine (2-core AMD EPYC): one
+#: mission of the embedded setup per smoothing round (--sweeps 1: 0.8 s in-process), and one
+#: Monte Carlo mission without rounds per worker (21 ms, docs/distributed.md)
+SWEEP_S = 0.8
+MISSION_S = 0.021
+#: A run estimated longer than this is announced before it starts
+LARGE_S = 60.0
+
+
+def announce_duration(sweeps: int, missions: int = 1, workers: int = 1) -> bool:
+    """Announce, in one line, a run whose estimated time exceeds :data:`LARGE_S`: ``missions``
+    of ``sweeps`` smoothing rounds shared by ``workers``. Returns whether it did."""
+    per_mission = SWEEP_S * sweeps if sweeps else MISSION_S
+    seconds = missions * per_mission / max(workers, 1)
+    if seconds <= LARGE_S:
+        return False
+    what = (f"{missions:,} mission(s)" + (f" on {workers} workers" if workers > 1 else "")
+            + f", {sweeps} smoothing round(s) per ping")
+    announce(f"a long run: {what}: about {seconds / 60:,.0f} min on a 2-core machine "
+             f"({per_mission:g} s per mission{' per round' if sweeps else ''}; --sweeps and "
+             "--monte-carlo set it) ...")
+    return True
 
 
 def heading_slices(args: argparse.Namespace) -> int:

@@ -27,7 +27,7 @@ def check(args: argparse.Namespace) -> None:
     """The Monte Carlo's checks before any work (``pool.check`` calls it): options that go
     together, the output paths, the Dask extra for --scheduler, and the memory of the workers
     and their chunks."""
-    from .pool import heading_slices, observer_bytes
+    from .pool import announce_duration, heading_slices, observer_bytes
 
     if args.scheduler and args.workers is not None:
         raise ValueError(f"give either --scheduler {args.scheduler} or --workers "
@@ -44,8 +44,10 @@ def check(args: argparse.Namespace) -> None:
                       "Dask distributed")
     args.mc_chunk = DEFAULT_CHUNK if args.mc_chunk is None else args.mc_chunk
     args.mc_seed = 0 if args.mc_seed is None else args.mc_seed
-    if args.scheduler:  # the memory is the cluster's workers', not this machine's
+    if args.scheduler:  # the memory and the time are the cluster's workers', not this machine's
         return
+    announce_duration(0 if args.sweeps is None else args.sweeps, args.monte_carlo,
+                      processes(args) or 1)
     chunk = min(args.mc_chunk, args.monte_carlo)
     per_task = WORKER_BYTES + observer_bytes(args.m, heading_slices(args)) \
         + chunk * BYTES_PER_MISSION
