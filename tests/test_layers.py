@@ -14,7 +14,7 @@ PKG = Path(boundest.__file__).parent
 #: the kernel archive's runtime (it reads the guard's paths), and helpers that import nothing
 #: of the package. The kernel archive's builder runs the command line: it sits on top.
 LAYERS: list[set[str]] = [
-    {"_numba_cache", "_malloc", "_textfile", "parallel"},
+    {"_numba_cache", "_malloc", "_textfile", "_progress", "parallel"},
     {"_kernels"},
     {"interval"},
     {"expr"},
