@@ -46,8 +46,6 @@ def check(args: argparse.Namespace) -> None:
     args.mc_seed = 0 if args.mc_seed is None else args.mc_seed
     if args.scheduler:  # the memory and the time are the cluster's workers', not this machine's
         return
-    announce_duration(0 if args.sweeps is None else args.sweeps, args.monte_carlo,
-                      processes(args) or 1)
     chunk = min(args.mc_chunk, args.monte_carlo)
     per_task = WORKER_BYTES + observer_bytes(args.m, heading_slices(args)) \
         + chunk * BYTES_PER_MISSION
@@ -56,6 +54,8 @@ def check(args: argparse.Namespace) -> None:
               f"--workers {args.workers} --mc-chunk {args.mc_chunk}")
     check_size(workers * per_task, f"{workers} process(es) at a time, each on a chunk of "
                f"{chunk:,} missions", option)
+    # after the memory: a run refused for its memory is not announced first
+    announce_duration(0 if args.sweeps is None else args.sweeps, args.monte_carlo, workers)
     cores = os.cpu_count() or 1
     if workers > cores:
         announce(f"--workers {args.workers}: {workers} worker processes for the {cores} cores "
