@@ -6,6 +6,7 @@ import math
 from fractions import Fraction
 
 import numpy as np
+import pytest
 
 from boundest import Interval
 
@@ -53,3 +54,12 @@ def engine_forward(name: str, x: Interval) -> Interval:
         lo[i], hi[i] = engine.image(code, float(x.lo.flat[i]), float(x.hi.flat[i]), 0.0, 0.0,
                                     0.0, buf, None, None, True, True)
     return Interval.trusted(lo, hi)
+
+
+def examples(full: int, default: int) -> pytest.MarkDecorator:
+    """Parametrize a property test by its number of hypothesis examples, ``n_examples``:
+    ``default`` in the suite's default part (quick, on every run), ``full`` in its slow part
+    (``pytest -m slow``, run by CI). The test builds its ``@given`` check inside."""
+    return pytest.mark.parametrize("n_examples", [
+        pytest.param(default, id=f"{default}-examples"),
+        pytest.param(full, id=f"{full}-examples", marks=pytest.mark.slow)])

@@ -18,6 +18,7 @@ from boundest.ctc import CtcFwdBwd, Fixpoint
 from boundest.expr import Model, Var
 from boundest.expr.functions import sqr
 
+from .checks import examples
 from .strategies import solvable_csps
 
 x, z = Var("x"), Var("z")
@@ -28,25 +29,30 @@ def csps():
     return solvable_csps((1, 3), 3, [0.0, 1e-9, 0.01, 0.3], 7)
 
 
-@settings(max_examples=120, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(csps(), st.sampled_from([(1e-8, 40), (1e-3, 12), (0.0, 52)]))
-def test_solutions_survive_box_consistency(csp, opts):
-    model, n, pts = csp
-    names = model.variable_names()
-    eps, depth = opts
-    ctc = CtcBox(model, names, eps=eps, max_depth=depth, max_steps=300)
-    hc = Fixpoint(CtcFwdBwd(model, names))
-    m = len(names)
-    # a batch: the full box, boxes around each solution point, an empty one
-    rows_lo = [[-np.inf] * m] + [[v - 0.3 for v in p] + [-np.inf] * (m - n) for p in pts]
-    rows_hi = [[np.inf] * m] + [[v + 0.3 for v in p] + [np.inf] * (m - n) for p in pts]
-    box = Interval.trusted(np.array([*rows_lo, [np.nan] * m]), np.array([*rows_hi, [np.nan] * m]))
-    for out in (ctc(box), ctc(hc(box)), Fixpoint(CtcBox(model, names) & hc)(box)):
-        for p in pts:
-            for r in range(len(pts) + 1):
-                if all(rows_lo[r][i] <= p[i] <= rows_hi[r][i] for i in range(n)):
-                    assert all(out.lo[r, i] <= p[i] <= out.hi[r, i] for i in range(n)), (r, p)
-        assert np.isnan(out.lo[-1]).all()
+@examples(120, 25)
+def test_solutions_survive_box_consistency(n_examples):
+    @settings(max_examples=n_examples, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+    @given(csps(), st.sampled_from([(1e-8, 40), (1e-3, 12), (0.0, 52)]))
+    def check(csp, opts):
+        model, n, pts = csp
+        names = model.variable_names()
+        eps, depth = opts
+        ctc = CtcBox(model, names, eps=eps, max_depth=depth, max_steps=300)
+        hc = Fixpoint(CtcFwdBwd(model, names))
+        m = len(names)
+        # a batch: the full box, boxes around each solution point, an empty one
+        rows_lo = [[-np.inf] * m] + [[v - 0.3 for v in p] + [-np.inf] * (m - n) for p in pts]
+        rows_hi = [[np.inf] * m] + [[v + 0.3 for v in p] + [np.inf] * (m - n) for p in pts]
+        box = Interval.trusted(np.array([*rows_lo, [np.nan] * m]),
+                               np.array([*rows_hi, [np.nan] * m]))
+        for out in (ctc(box), ctc(hc(box)), Fixpoint(CtcBox(model, names) & hc)(box)):
+            for p in pts:
+                for r in range(len(pts) + 1):
+                    if all(rows_lo[r][i] <= p[i] <= rows_hi[r][i] for i in range(n)):
+                        assert all(out.lo[r, i] <= p[i] <= out.hi[r, i] for i in range(n)), (r, p)
+            assert np.isnan(out.lo[-1]).all()
+
+    check()
 
 
 @settings(max_examples=200, deadline=None)

@@ -34,6 +34,7 @@ from boundest.ctc import (
 from boundest.expr import Const, Model, Op, Var, parse_model
 from boundest.expr.tape import compile_model
 
+from .checks import examples
 from .strategies import ulps_apart
 
 decimal_interval = Interval.from_decimal  # the public entry of boundest.interval.decimal
@@ -352,36 +353,40 @@ def test_fwdbwd_keeps_every_solution(scenario):
         assert_point_kept(dom, box, p)
 
 
-@settings(max_examples=200, suppress_health_check=[HealthCheck.filter_too_much,
-                                                   HealthCheck.too_slow])
-@given(scenarios(n_constraints=(1,)), st.data())
-def test_equality_with_a_result_variable_keeps_the_solution(scenario, data):
+@examples(200, 40)
+def test_equality_with_a_result_variable_keeps_the_solution(n_examples):
     """``w == f(x, y, z)`` with ``w`` a variable whose value is the exact ``f(p)``."""
-    p, box, cons = scenario
-    t, v, _, target = cons[0]
-    m = Model()
-    for n in NAMES:
-        m.declare(n)
-    m.add(w == to_expr(t))
-    names = [*NAMES, "w"]
-    box4 = Interval([*box.lo, target.lo], [*box.hi, target.hi])
-    note(f"box {box4}")
-    ctc = CtcFwdBwd(m, names)
-    for c in (ctc, Fixpoint(ctc, max_iter=30)):
-        r = c(box4)
-        assert_point_kept(r[:3], box, p)
-        assert mp_in(v, float(r.lo[3]), float(r.hi[3])), f"lost w = f(p): {r}"
-        assert np.all(r.is_subset(box4))
-    doms = {n: box4[i] for i, n in enumerate(names)}
-    if data.draw(st.booleans()):  # the same through a compiled tape
-        res = propagate(compile_model(m), domains=doms, mode="hc4")
-    else:
-        res = propagate(m, domains=doms, mode="hc4")
-    assert res.consistent
-    for i, n in enumerate(NAMES):
-        assert mp_in(mpmath.mpf(p[n]), float(res[n].lo), float(res[n].hi)), n
-        assert res[n].is_subset(box[i])
-    assert mp_in(v, float(res["w"].lo), float(res["w"].hi))
+    @settings(max_examples=n_examples, suppress_health_check=[HealthCheck.filter_too_much,
+                                                       HealthCheck.too_slow])
+    @given(scenarios(n_constraints=(1,)), st.data())
+    def check(scenario, data):
+        p, box, cons = scenario
+        t, v, _, target = cons[0]
+        m = Model()
+        for n in NAMES:
+            m.declare(n)
+        m.add(w == to_expr(t))
+        names = [*NAMES, "w"]
+        box4 = Interval([*box.lo, target.lo], [*box.hi, target.hi])
+        note(f"box {box4}")
+        ctc = CtcFwdBwd(m, names)
+        for c in (ctc, Fixpoint(ctc, max_iter=30)):
+            r = c(box4)
+            assert_point_kept(r[:3], box, p)
+            assert mp_in(v, float(r.lo[3]), float(r.hi[3])), f"lost w = f(p): {r}"
+            assert np.all(r.is_subset(box4))
+        doms = {n: box4[i] for i, n in enumerate(names)}
+        if data.draw(st.booleans()):  # the same through a compiled tape
+            res = propagate(compile_model(m), domains=doms, mode="hc4")
+        else:
+            res = propagate(m, domains=doms, mode="hc4")
+        assert res.consistent
+        for i, n in enumerate(NAMES):
+            assert mp_in(mpmath.mpf(p[n]), float(res[n].lo), float(res[n].hi)), n
+            assert res[n].is_subset(box[i])
+        assert mp_in(v, float(res["w"].lo), float(res["w"].hi))
+
+    check()
 
 
 @settings(max_examples=100)

@@ -21,6 +21,8 @@ from boundest.estimation.cells import CellGrid
 from boundest.paving import Subpaving, image
 from boundest.paving.image import _unique_rows, cell_range, grid_step, pave
 
+from .checks import examples
+
 
 @contextmanager
 def _no_grid() -> Iterator[None]:
@@ -66,21 +68,25 @@ def _problem(seed: int, as_box: bool) -> tuple[Subpaving, Subpaving | Interval, 
     return v_in, v_out, pts
 
 
-@settings(max_examples=12, deadline=None)
-@given(st.integers(0, 2**31), st.sampled_from([0.02, 0.05, 0.1]), st.booleans())
-def test_image_operator_keeps_the_exact_images(seed, eps, as_box):
-    v_in, v_out, pts = _problem(seed, as_box)
-    out = PavingSets(eps=eps).toward_out(F, v_out, v_in)
-    vb = v_out.boxes if isinstance(v_out, Subpaving) else v_out.reshape(1, -1)
-    ob = out.boxes if isinstance(out, Subpaving) else out.reshape(1, -1)
-    kept = 0
-    with mpmath.workdps(40):
-        for p in pts:
-            q = _exact_f(p)
-            if _exact_in(q, vb):  # a point of V_out ∩ f(V_in)
-                kept += 1
-                assert _exact_in(q, ob), (p, q)
-    assert kept > 0
+@examples(12, 4)
+def test_image_operator_keeps_the_exact_images(n_examples):
+    @settings(max_examples=n_examples, deadline=None)
+    @given(st.integers(0, 2**31), st.sampled_from([0.02, 0.05, 0.1]), st.booleans())
+    def check(seed, eps, as_box):
+        v_in, v_out, pts = _problem(seed, as_box)
+        out = PavingSets(eps=eps).toward_out(F, v_out, v_in)
+        vb = v_out.boxes if isinstance(v_out, Subpaving) else v_out.reshape(1, -1)
+        ob = out.boxes if isinstance(out, Subpaving) else out.reshape(1, -1)
+        kept = 0
+        with mpmath.workdps(40):
+            for p in pts:
+                q = _exact_f(p)
+                if _exact_in(q, vb):  # a point of V_out ∩ f(V_in)
+                    kept += 1
+                    assert _exact_in(q, ob), (p, q)
+        assert kept > 0
+
+    check()
 
 
 @settings(max_examples=8, deadline=None)

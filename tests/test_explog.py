@@ -20,7 +20,7 @@ from hypothesis import strategies as st
 from boundest import Interval
 from boundest.interval import explog as ex
 
-from .checks import engine_forward, is_empty, same, subset, valid
+from .checks import engine_forward, examples, is_empty, same, subset, valid
 from .strategies import intervals, point_in, ulps_apart
 
 mpmath.mp.prec = 256
@@ -551,21 +551,25 @@ REV = {
 
 
 @pytest.mark.parametrize("name", sorted(REV))
-@settings(max_examples=300, deadline=None)
-@given(data=st.data())
-def test_unary_rev_keeps_every_solution(name, data):
-    rev, exact, dom = REV[name]
-    x = data.draw(intervals())
-    a = data.draw(point_in(x))
-    assume(dom(a))
-    # enough bits that f(a) is not rounded onto a float (cosh(1e-296) = 1 + 5e-593)
-    with mpmath.workprec(2400):
-        v = exact(mp(a))
-    z = data.draw(around(v))
-    r = rev(z, x)
-    assert valid(r)
-    assert subset(r, x), (x, z, r)
-    assert r.contains(a), (name, x, a, z, r)
+@examples(300, 60)
+def test_unary_rev_keeps_every_solution(name, n_examples):
+    @settings(max_examples=n_examples, deadline=None)
+    @given(data=st.data())
+    def check(data):
+        rev, exact, dom = REV[name]
+        x = data.draw(intervals())
+        a = data.draw(point_in(x))
+        assume(dom(a))
+        # enough bits that f(a) is not rounded onto a float (cosh(1e-296) = 1 + 5e-593)
+        with mpmath.workprec(2400):
+            v = exact(mp(a))
+        z = data.draw(around(v))
+        r = rev(z, x)
+        assert valid(r)
+        assert subset(r, x), (x, z, r)
+        assert r.contains(a), (name, x, a, z, r)
+
+    check()
 
 
 @pytest.mark.parametrize("name", sorted(REV))
@@ -710,20 +714,24 @@ def test_atan2_rev_edges():
 # reverse, pow
 # -------------------------------------------------------------------------------------------
 
-@settings(max_examples=500, deadline=None)
-@given(data=st.data())
-def test_pow_rev_keeps_every_solution(data):
-    x, y = data.draw(intervals()), data.draw(intervals())
-    xp = meet_positive(x)
-    assume(xp is not None)
-    a, b = data.draw(point_in(xp)), data.draw(point_in(y))
-    v = exact_pow(a, b)
-    assume(v is not None)
-    z = data.draw(around(v))
-    x2, y2 = ex.pow_rev(z, x, y)
-    assert valid(x2) and valid(y2)
-    assert subset(x2, x) and subset(y2, y)
-    assert x2.contains(a) and y2.contains(b), (z, x, y, a, b, x2, y2)
+@examples(500, 100)
+def test_pow_rev_keeps_every_solution(n_examples):
+    @settings(max_examples=n_examples, deadline=None)
+    @given(data=st.data())
+    def check(data):
+        x, y = data.draw(intervals()), data.draw(intervals())
+        xp = meet_positive(x)
+        assume(xp is not None)
+        a, b = data.draw(point_in(xp)), data.draw(point_in(y))
+        v = exact_pow(a, b)
+        assume(v is not None)
+        z = data.draw(around(v))
+        x2, y2 = ex.pow_rev(z, x, y)
+        assert valid(x2) and valid(y2)
+        assert subset(x2, x) and subset(y2, y)
+        assert x2.contains(a) and y2.contains(b), (z, x, y, a, b, x2, y2)
+
+    check()
 
 
 @settings(max_examples=200, deadline=None)

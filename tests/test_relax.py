@@ -31,6 +31,7 @@ from boundest.expr import functions as fn
 from boundest.expr.tape import OPS, compile_model
 from boundest.interval import Interval
 
+from .checks import examples
 from .exact_lp import exact_min
 from .strategies import solvable_csps
 
@@ -218,32 +219,37 @@ def _dense(ext):
     return A, s.b_lo, s.b_hi
 
 
-@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(st.sampled_from([("mul", lambda: z == x * y), ("sqr", lambda: z == fn.sqr(x) + y),
-                        ("exp", lambda: z == fn.exp(x) - y), ("sqrt", lambda: z == fn.sqrt(x))]),
-       st.integers(-3, 2), st.integers(1, 3), st.integers(-3, 2), st.integers(1, 3),
-       st.sampled_from([-1.0, 1.0]), st.integers(0, 3))
-def test_relaxed_lp_bound_below_exact_optimum(case, a, w, b, v, sense, col):
+@examples(60, 12)
+def test_relaxed_lp_bound_below_exact_optimum(n_examples):
     """The rigorous bound of the relaxed LP is at most its exact rational optimum."""
-    _, cons = case
-    tape, lo, hi = _tape_box(cons(), {"x": (a / 2, (a + w) / 2), "y": (b / 2, (b + v) / 2),
-                                      "z": (-20.0, 20.0)})
-    if tape.n_slots > 4:
-        return
-    lo[~np.isfinite(lo)], hi[~np.isfinite(hi)] = -50.0, 50.0
-    ext = extract(tape, lo, hi, log_linear=False, relax=True)
-    if ext.system.n_rows == 0:
-        return
-    A, b_lo, b_hi = _dense(ext)
-    c = np.zeros(tape.n_slots)
-    c[col % tape.n_slots] = sense
-    exact = exact_min(c, A, b_lo, b_hi, lo, hi)
-    bound = lp_bound(ext.system, c, lo, hi)
-    if exact is None:
-        return
-    assert bound != np.inf
-    assert bound <= exact, (bound, exact)
-    assert bound >= float(exact) - 1e-6 * (1 + abs(float(exact)))  # and nearly tight
+    @settings(max_examples=n_examples, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+    @given(st.sampled_from([("mul", lambda: z == x * y), ("sqr", lambda: z == fn.sqr(x) + y),
+                            ("exp", lambda: z == fn.exp(x) - y),
+                            ("sqrt", lambda: z == fn.sqrt(x))]),
+           st.integers(-3, 2), st.integers(1, 3), st.integers(-3, 2), st.integers(1, 3),
+           st.sampled_from([-1.0, 1.0]), st.integers(0, 3))
+    def check(case, a, w, b, v, sense, col):
+        _, cons = case
+        tape, lo, hi = _tape_box(cons(), {"x": (a / 2, (a + w) / 2), "y": (b / 2, (b + v) / 2),
+                                          "z": (-20.0, 20.0)})
+        if tape.n_slots > 4:
+            return
+        lo[~np.isfinite(lo)], hi[~np.isfinite(hi)] = -50.0, 50.0
+        ext = extract(tape, lo, hi, log_linear=False, relax=True)
+        if ext.system.n_rows == 0:
+            return
+        A, b_lo, b_hi = _dense(ext)
+        c = np.zeros(tape.n_slots)
+        c[col % tape.n_slots] = sense
+        exact = exact_min(c, A, b_lo, b_hi, lo, hi)
+        bound = lp_bound(ext.system, c, lo, hi)
+        if exact is None:
+            return
+        assert bound != np.inf
+        assert bound <= exact, (bound, exact)
+        assert bound >= float(exact) - 1e-6 * (1 + abs(float(exact)))  # and nearly tight
+
+    check()
 
 
 def _model_x_y(cons, box=(-3.0, 3.0)):

@@ -22,6 +22,7 @@ from boundest import Interval, Var
 from boundest.tube import ContractorNetwork, CtcDeriv, CtcEval, CtcSlices, Tube
 from boundest.tube.eval import invert_kernel
 
+from .checks import examples
 from .test_tube import grids, inside, sample_times, seeds, trajectories, tube_around, tube_keeps
 
 INF = math.inf
@@ -273,24 +274,28 @@ def test_eval_codac_dependency_on_t_plain():
     assert Z.hi[1] == pytest.approx(-math.sin(6.2), rel=1e-14) and Z.hi[1] >= -math.sin(6.2)
 
 
-@settings(max_examples=40)
-@given(trajectories(), trajectories(), grids(), seeds, st.floats(0, 1), st.floats(0, 1),
-       st.floats(0, 1), st.sampled_from([0.0, 1e-3, 0.1, 1.0]), st.booleans())
-def test_eval_vector_keeps_truth(tr1, tr2, t, seed, where, left, right, zrad, time_deriv):
-    # two components measured at the same uncertain time: the time pieces common to both
-    # components, slice by slice, keep the true time, values and trajectories
-    rng = np.random.default_rng(seed)
-    y = Tube.stack([tube_around(tr1, t, rng), tube_around(tr2, t, rng)])
-    w = Tube.stack([tube_around(tr1, t, rng, deriv=True), tube_around(tr2, t, rng, deriv=True)])
-    ts = float(t[0] + where * (t[-1] - t[0]))
-    tm = Interval(ts - left * (ts - t[0]), ts + right * (t[-1] - ts))
-    v1, v2 = tr1.value(ts), tr2.value(ts)
-    z = Interval([float(v1) - zrad - 1e-9, float(v2) - zrad - 1e-9],
-                 [float(v1) + zrad + 1e-9, float(v2) + zrad + 1e-9])
-    tm, z = CtcEval(time_deriv).contract(tm, z, y, w)
-    assert inside(tm, mpmath.mpf(ts)) and inside(z[0], v1) and inside(z[1], v2)
-    times = sample_times(t, rng)
-    assert tube_keeps(y[0], tr1, times) and tube_keeps(y[1], tr2, times)
+@examples(40, 10)
+def test_eval_vector_keeps_truth(n_examples):
+    @settings(max_examples=n_examples)
+    @given(trajectories(), trajectories(), grids(), seeds, st.floats(0, 1), st.floats(0, 1),
+           st.floats(0, 1), st.sampled_from([0.0, 1e-3, 0.1, 1.0]), st.booleans())
+    def check(tr1, tr2, t, seed, where, left, right, zrad, time_deriv):
+        # two components measured at the same uncertain time: the time pieces common to both
+        # components, slice by slice, keep the true time, values and trajectories
+        rng = np.random.default_rng(seed)
+        y = Tube.stack([tube_around(tr1, t, rng), tube_around(tr2, t, rng)])
+        w = Tube.stack([tube_around(tr1, t, rng, deriv=True), tube_around(tr2, t, rng, deriv=True)])
+        ts = float(t[0] + where * (t[-1] - t[0]))
+        tm = Interval(ts - left * (ts - t[0]), ts + right * (t[-1] - ts))
+        v1, v2 = tr1.value(ts), tr2.value(ts)
+        z = Interval([float(v1) - zrad - 1e-9, float(v2) - zrad - 1e-9],
+                     [float(v1) + zrad + 1e-9, float(v2) + zrad + 1e-9])
+        tm, z = CtcEval(time_deriv).contract(tm, z, y, w)
+        assert inside(tm, mpmath.mpf(ts)) and inside(z[0], v1) and inside(z[1], v2)
+        times = sample_times(t, rng)
+        assert tube_keeps(y[0], tr1, times) and tube_keeps(y[1], tr2, times)
+
+    check()
 
 
 @settings(max_examples=60)

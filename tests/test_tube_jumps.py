@@ -23,6 +23,7 @@ from hypothesis import strategies as st
 from boundest import Interval, Var
 from boundest.tube import ContractorNetwork, CtcDeriv, CtcEval, CtcSlices, Tube
 
+from .checks import examples
 from .test_tube import Traj, grids, inside, sample_times, seeds, trajectories, widen
 
 INF = math.inf
@@ -201,44 +202,52 @@ def test_held_samples_vector_zero_order_hold():
 
 
 # -- property tests: the truth survives --
-@settings(max_examples=60, deadline=None)
-@given(cases(), seeds)
-def test_deriv_with_jumps_keeps_truth(case, seed):
-    t, jp = case
-    rng = np.random.default_rng(seed)
-    v = derivative_tube(jp, t, rng)
-    assert keeps(v, jp.v, sample_times(t, rng, 30))  # the derivative tube itself
-    x = state_tube(jp, t, rng)
-    CtcDeriv().contract(x, v)
-    assert not x.is_empty() and x.continuous
-    times = sample_times(t, rng)
-    assert keeps(x, jp.x, times)
-    # and backward: from a last gate only
-    xb = Tube(t, Interval.entire(t.size - 1))
-    xb.gates[-1] = Interval(float(jp.x(float(t[-1])))).inflate(1e-9)
-    CtcDeriv().contract(xb, v)
-    assert keeps(xb, jp.x, times)
+@examples(60, 12)
+def test_deriv_with_jumps_keeps_truth(n_examples):
+    @settings(max_examples=n_examples, deadline=None)
+    @given(cases(), seeds)
+    def check(case, seed):
+        t, jp = case
+        rng = np.random.default_rng(seed)
+        v = derivative_tube(jp, t, rng)
+        assert keeps(v, jp.v, sample_times(t, rng, 30))  # the derivative tube itself
+        x = state_tube(jp, t, rng)
+        CtcDeriv().contract(x, v)
+        assert not x.is_empty() and x.continuous
+        times = sample_times(t, rng)
+        assert keeps(x, jp.x, times)
+        # and backward: from a last gate only
+        xb = Tube(t, Interval.entire(t.size - 1))
+        xb.gates[-1] = Interval(float(jp.x(float(t[-1])))).inflate(1e-9)
+        CtcDeriv().contract(xb, v)
+        assert keeps(xb, jp.x, times)
+
+    check()
 
 
-@settings(max_examples=40, deadline=None)
-@given(cases(), seeds, st.floats(0, 1), st.floats(0, 0.3), st.floats(0, 0.5))
-def test_eval_with_jumps_keeps_truth(case, seed, u, dt, dz):
-    t, jp = case
-    rng = np.random.default_rng(seed)
-    v = derivative_tube(jp, t, rng)
-    y = state_tube(jp, t, rng) if rng.random() < 0.5 else Tube(t, Interval.entire(t.size - 1))
-    t_true = float(t[0] + u * (t[-1] - t[0]))
-    if rng.random() < 0.3:
-        t_true = float(t[rng.integers(t.size)])  # at a gate, where v jumps
-    z_true = jp.x(t_true)
-    T = Interval(max(t_true - dt, t[0]), min(t_true + dt, t[-1]))
-    z = Interval(float(z_true)).inflate(1e-9 + dz)
-    assert inside(z, z_true)
-    CtcEval().contract(T, z, y, v)
-    assert not y.is_empty()
-    assert float(T.lo) <= t_true <= float(T.hi)
-    assert inside(z, z_true)
-    assert keeps(y, jp.x, sample_times(t, rng))
+@examples(40, 10)
+def test_eval_with_jumps_keeps_truth(n_examples):
+    @settings(max_examples=n_examples, deadline=None)
+    @given(cases(), seeds, st.floats(0, 1), st.floats(0, 0.3), st.floats(0, 0.5))
+    def check(case, seed, u, dt, dz):
+        t, jp = case
+        rng = np.random.default_rng(seed)
+        v = derivative_tube(jp, t, rng)
+        y = state_tube(jp, t, rng) if rng.random() < 0.5 else Tube(t, Interval.entire(t.size - 1))
+        t_true = float(t[0] + u * (t[-1] - t[0]))
+        if rng.random() < 0.3:
+            t_true = float(t[rng.integers(t.size)])  # at a gate, where v jumps
+        z_true = jp.x(t_true)
+        T = Interval(max(t_true - dt, t[0]), min(t_true + dt, t[-1]))
+        z = Interval(float(z_true)).inflate(1e-9 + dz)
+        assert inside(z, z_true)
+        CtcEval().contract(T, z, y, v)
+        assert not y.is_empty()
+        assert float(T.lo) <= t_true <= float(T.hi)
+        assert inside(z, z_true)
+        assert keeps(y, jp.x, sample_times(t, rng))
+
+    check()
 
 
 @pytest.mark.slow  # about 20 s on 2 cores
@@ -263,25 +272,29 @@ def test_integrals_with_jumps_keep_truth(case, seed, a, b, r):
     assert keeps(prim, jp.x, sample_times(t, rng))
 
 
-@settings(max_examples=25, deadline=None)
-@given(cases(), seeds)
-def test_network_with_held_input_keeps_truth(case, seed):
+@examples(25, 6)
+def test_network_with_held_input_keeps_truth(n_examples):
     """``x' = v``, ``v = 2 u - 1`` with ``u`` a held input: CtcSlices acts on jump tubes."""
-    t, jp = case
-    rng = np.random.default_rng(seed)
-    # u = (v + 1) / 2 is the held input; v is unknown (entire, with jumps)
-    vs = widen(jp.v_slices(t), rng)
-    u = Tube.piecewise_constant(t, (vs + 1) / 2)
-    v = Tube.piecewise_constant(t, Interval.entire(t.size - 1))
-    x = state_tube(jp, t, rng)
-    U, V = Var("u"), Var("v")
-    cn = ContractorNetwork()
-    cn.add(CtcSlices([V == 2 * U - 1], ["u", "v"]), [u, v])
-    cn.add(CtcDeriv(), [x, v])
-    report = cn.contract()
-    assert not report.empty
-    times = sample_times(t, rng)
-    assert keeps(x, jp.x, times)
-    # away from the gates v is enclosed (at a gate, v(t_i) is either neighbour's value)
-    inner = times[~np.isin(times, t)]
-    assert keeps(v, jp.v, inner)
+    @settings(max_examples=n_examples, deadline=None)
+    @given(cases(), seeds)
+    def check(case, seed):
+        t, jp = case
+        rng = np.random.default_rng(seed)
+        # u = (v + 1) / 2 is the held input; v is unknown (entire, with jumps)
+        vs = widen(jp.v_slices(t), rng)
+        u = Tube.piecewise_constant(t, (vs + 1) / 2)
+        v = Tube.piecewise_constant(t, Interval.entire(t.size - 1))
+        x = state_tube(jp, t, rng)
+        U, V = Var("u"), Var("v")
+        cn = ContractorNetwork()
+        cn.add(CtcSlices([V == 2 * U - 1], ["u", "v"]), [u, v])
+        cn.add(CtcDeriv(), [x, v])
+        report = cn.contract()
+        assert not report.empty
+        times = sample_times(t, rng)
+        assert keeps(x, jp.x, times)
+        # away from the gates v is enclosed (at a gate, v(t_i) is either neighbour's value)
+        inner = times[~np.isin(times, t)]
+        assert keeps(v, jp.v, inner)
+
+    check()

@@ -17,6 +17,8 @@ from boundest.expr import Model, Var, VarFamily
 from boundest.expr.function_tape import constraint_functions
 from boundest.interval import Interval
 
+from .checks import examples
+
 
 def _tableau(A, ld, ud, ls, us):
     m, n = A.shape
@@ -175,24 +177,28 @@ def test_a_tape_without_its_model_is_refused_by_the_centered_modes():
         Centered(window=4, stride=5)
 
 
-@settings(deadline=None, max_examples=40)
-@given(st.integers(0, 10_000))
-def test_ctc_centered_lp_keeps_a_known_solution(seed):
+@examples(40, 10)
+def test_ctc_centered_lp_keeps_a_known_solution(n_examples):
     """Random polynomial and trigonometric constraints through a random point: every box
     around the point keeps it after CtcCentered(precondition="lp")."""
-    rng = np.random.default_rng(seed)
-    x, y, z = Var("x"), Var("y"), Var("z")
-    p = rng.uniform(-2, 2, 3)
-    exprs = [x * y + bd.sin(z), x**2 - y * z + 0.5 * x, bd.cos(x) * z + y]
-    vals = [p[0] * p[1] + np.sin(p[2]), p[0] ** 2 - p[1] * p[2] + 0.5 * p[0],
-            np.cos(p[0]) * p[2] + p[1]]
-    m = Model()
-    for e, v in zip(exprs[: int(rng.integers(1, 4))], vals, strict=False):
-        m.add(e - v >= -1e-9, e - v <= 1e-9)
-    names = m.variable_names()
-    point = np.array([dict(zip("xyz", p, strict=True))[n] for n in names])
-    r = rng.uniform(0.001, 0.5, (20, len(names)))
-    off = rng.uniform(0, 1, (20, len(names)))
-    box = Interval(point - r * off, point + r * (1 - off))
-    out = bd.CtcCentered(m, precondition="lp")(box)
-    assert np.all(out.lo <= point) and np.all(point <= out.hi)
+    @settings(deadline=None, max_examples=n_examples)
+    @given(st.integers(0, 10_000))
+    def check(seed):
+        rng = np.random.default_rng(seed)
+        x, y, z = Var("x"), Var("y"), Var("z")
+        p = rng.uniform(-2, 2, 3)
+        exprs = [x * y + bd.sin(z), x**2 - y * z + 0.5 * x, bd.cos(x) * z + y]
+        vals = [p[0] * p[1] + np.sin(p[2]), p[0] ** 2 - p[1] * p[2] + 0.5 * p[0],
+                np.cos(p[0]) * p[2] + p[1]]
+        m = Model()
+        for e, v in zip(exprs[: int(rng.integers(1, 4))], vals, strict=False):
+            m.add(e - v >= -1e-9, e - v <= 1e-9)
+        names = m.variable_names()
+        point = np.array([dict(zip("xyz", p, strict=True))[n] for n in names])
+        r = rng.uniform(0.001, 0.5, (20, len(names)))
+        off = rng.uniform(0, 1, (20, len(names)))
+        box = Interval(point - r * off, point + r * (1 - off))
+        out = bd.CtcCentered(m, precondition="lp")(box)
+        assert np.all(out.lo <= point) and np.all(point <= out.hi)
+
+    check()
