@@ -182,3 +182,47 @@ def test_demo_with_an_empty_cache_compiles_nothing_when_the_archive_matches(tmp_
     log = json.loads((tmp_path / "log.json").read_text())
     assert log == {"compiled": [], "status": "installed"}
     assert "compiling" not in out.stderr
+
+
+_USER_MODEL = """
+import json
+from numba.core import event
+compiled = []
+class Log(event.Listener):
+    def on_start(self, ev):
+        compiled.append(repr((ev.data or {}).get("dispatcher")))
+    def on_end(self, ev):
+        pass
+event.register("numba:compile", Log())
+import boundest as bd
+import boundest._kernels as k
+from boundest.expr import parse_model
+m = parse_model("Variables x in [-2, 2], y in [-2, 2];\\n"
+                "Constraints sin(x) + exp(y) = 1.5, x - y = 0;")
+box = bd.Interval([-2.0, -2.0], [2.0, 2.0])
+bd.CtcCentered(m)(box)
+bd.CtcCentered(m, hc4=True)(box)
+bd.CtcNewton(m).prove(box)
+roots = bd.solve_square(m, box)
+bd.jacobian(m, box)
+bd.centered_form(m, box)
+print(json.dumps({"compiled": compiled, "status": k.STATUS, "proved": len(roots.solutions)}))
+"""
+
+
+@pytest.mark.slow  # a subprocess, about 10 s with the archive
+def test_a_users_model_through_the_derivative_api_compiles_nothing(tmp_path):
+    """The centered-form contractor, interval Newton, ``solve_square``, ``jacobian`` and
+    ``centered_form`` on a model of one's own (trig and exp/log operators) load their kernels
+    from the archive (they compiled for 1-2 minutes on first use before it held them)."""
+    why = k.refusal(k.read_manifest())
+    if why is not None:
+        pytest.skip(f"kernel archive {why}")
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), MPLBACKEND="Agg")
+    for var in (k.ENV_SWITCH, "NUMBA_CPU_NAME", "NUMBA_CPU_FEATURES"):
+        env.pop(var, None)
+    out = subprocess.run([sys.executable, "-c", _USER_MODEL], env=env, capture_output=True,
+                         text=True, timeout=600)
+    assert out.returncode == 0, out.stderr[-2000:]
+    log = json.loads(out.stdout.strip().splitlines()[-1])
+    assert log == {"compiled": [], "status": "installed", "proved": 1}, log

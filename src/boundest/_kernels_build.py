@@ -130,6 +130,7 @@ def _build_all_ufuncs() -> int:
 
     qinter(Interval([[0.0], [1.0]], [[2.0], [3.0]]), 1)
     _build_engine_variants()
+    _build_derivative_variants()
     return 0
 
 
@@ -161,6 +162,43 @@ def _build_engine_variants() -> None:
                                 f"Constraints z = {terms};")
             propagate(model)  # the default mode: hull consistency, shaving, centered
             CtcFwdBwd(model, ["x", "y", "z"])(Interval([-1.0, -1.0, -9.0], [1.0, 1.0, 9.0]))
+
+
+def _family_models(max_families: int = 4):
+    """A square model (2 equations, 2 unknowns in ``[-1, 1]^2``) for each combination of at
+    most ``max_families`` operator families, with the combination's name."""
+    from itertools import combinations
+
+    from .expr import parse_model
+
+    names = list(_FAMILY_TERMS)
+    for r in range(max_families + 1):
+        for chosen in combinations(names, r):
+            terms = " + ".join(["y", *(_FAMILY_TERMS[n] for n in chosen)])
+            yield "+".join(chosen) or "basic", parse_model(
+                f"Variables x in [-1, 1], y in [-1, 1];\n"
+                f"Constraints {terms} = 0.5, x - y = 0;")
+
+
+def _build_derivative_variants() -> None:
+    """Compile the derivative-based kernels of the library (``jacobian``, ``centered_form``,
+    ``CtcCentered``, ``CtcNewton``, ``solve_square``) for every combination of operator
+    families: like the default mode's kernels, they are specialised per combination, and a
+    user's first ``CtcCentered`` or ``solve_square`` on a model of their own otherwise
+    compiles for a minute or more on 2 cores."""
+    from .ctc import CtcCentered, CtcNewton
+    from .ctc.derivatives import centered, jacobian
+    from .interval import Interval
+    from .paving import solve_square
+
+    box = Interval([-1.0, -1.0], [1.0, 1.0])
+    for _, model in _family_models():
+        jacobian(model, box)
+        centered(model, box)
+        for ctc in (CtcCentered(model), CtcCentered(model, hc4=True)):
+            ctc(box)
+        CtcNewton(model).prove(box)
+        solve_square(model, box, eps=1e-3)
 
 
 def build(names: list[str] | None = None, timeout: float = 1800.0) -> int:
