@@ -33,6 +33,7 @@ from boundest.expr import Model, Var
 from boundest.expr.tape import compile_model
 from boundest.interval import Interval
 
+from .checks import examples
 from .exact_lp import exact_min
 
 SETTINGS = settings(max_examples=150, deadline=None,
@@ -284,28 +285,32 @@ def test_feasible_points_survive(a, b, p, q, ra, rb, log_linear):
         assert lo[s] <= val <= hi[s], (name, val, lo[s], hi[s])
 
 
-@SETTINGS
-@given(st.lists(dyadic, min_size=4, max_size=4), st.integers(1, 3))
-def test_radius_is_a_sound_relaxation(vals, radius):
-    # a chain x_{k+1} = x_k + 0.5 d_k: local LPs (few rows) keep the point, like the full one
-    xs = [Var(f"x{k}") for k in range(5)]
-    ds = [Var(f"d{k}") for k in range(4)]
-    m = Model()
-    pt = [0.0]
-    for k in range(4):
-        pt.append(pt[-1] + 0.5 * vals[k])
-    for k in range(4):
-        m.declare(ds[k], (vals[k] - 0.5, vals[k] + 0.25))
-        m.add(xs[k + 1] == xs[k] + 0.5 * ds[k])
-    m.declare(xs[0], (-0.125, 0.125))
-    m.declare(xs[4], (pt[4] - 0.25, pt[4] + 0.5))
-    t = compile_model(m)
-    for rad in (radius, None):
-        lo, hi, ok = contract_slots(t, t.lo, t.hi, radius=rad)
-        assert ok
-        for k in range(5):
-            s = t.slot_of[f"x{k}"]
-            assert lo[s] <= pt[k] <= hi[s]
+@examples(150, 30)
+def test_radius_is_a_sound_relaxation(n_examples):
+    @settings(SETTINGS, max_examples=n_examples)
+    @given(st.lists(dyadic, min_size=4, max_size=4), st.integers(1, 3))
+    def check(vals, radius):
+        # a chain x_{k+1} = x_k + 0.5 d_k: local LPs (few rows) keep the point, like the full one
+        xs = [Var(f"x{k}") for k in range(5)]
+        ds = [Var(f"d{k}") for k in range(4)]
+        m = Model()
+        pt = [0.0]
+        for k in range(4):
+            pt.append(pt[-1] + 0.5 * vals[k])
+        for k in range(4):
+            m.declare(ds[k], (vals[k] - 0.5, vals[k] + 0.25))
+            m.add(xs[k + 1] == xs[k] + 0.5 * ds[k])
+        m.declare(xs[0], (-0.125, 0.125))
+        m.declare(xs[4], (pt[4] - 0.25, pt[4] + 0.5))
+        t = compile_model(m)
+        for rad in (radius, None):
+            lo, hi, ok = contract_slots(t, t.lo, t.hi, radius=rad)
+            assert ok
+            for k in range(5):
+                s = t.slot_of[f"x{k}"]
+                assert lo[s] <= pt[k] <= hi[s]
+
+    check()
 
 
 finite = st.floats(-1e300, 1e300, allow_nan=False, allow_subnormal=True)

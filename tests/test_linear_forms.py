@@ -62,7 +62,7 @@ def _inside(d, dl, dh) -> bool:
     return bool(np.all((dl <= d) & (d <= dh)))
 
 
-@examples(300, 60)
+@examples(300, 20)
 def test_contract_rows_keeps_the_point(n_examples):
     @settings(max_examples=n_examples, deadline=None)
     @given(linear_systems(), st.booleans())

@@ -172,30 +172,34 @@ def test_huge_pown_rows_hold_on_the_graph(n, box):
         _check_rows(tape, lo, hi, {sx: M(p), sz: v})
 
 
-@SETTINGS
-@given(st.sampled_from(["mul", "div", "min", "max", "square"]), st.data())
-def test_binary_rows_hold_on_the_graph(name, data):
-    (xl, xh), (yl, yh), (zl, zh) = (data.draw(boxes()) for _ in range(3))
-    if name == "div":  # the rows hold for every y != 0 and z in its domain: x = z y
-        tape, lo, hi = _tape_box(z == x / y, {"x": (-math.inf, math.inf), "y": (yl, yh),
-                                              "z": (zl, zh)})
-        for q in _points(data.draw, yl, yh, 3):
-            for r in _points(data.draw, zl, zh, 3):
-                vals = {tape.slot_of["y"]: M(q), tape.slot_of["z"]: M(r),
-                        tape.slot_of["x"]: M(q) * M(r)}
+@examples(150, 30)
+def test_binary_rows_hold_on_the_graph(n_examples):
+    @settings(SETTINGS, max_examples=n_examples)
+    @given(st.sampled_from(["mul", "div", "min", "max", "square"]), st.data())
+    def check(name, data):
+        (xl, xh), (yl, yh), (zl, zh) = (data.draw(boxes()) for _ in range(3))
+        if name == "div":  # the rows hold for every y != 0 and z in its domain: x = z y
+            tape, lo, hi = _tape_box(z == x / y, {"x": (-math.inf, math.inf), "y": (yl, yh),
+                                                  "z": (zl, zh)})
+            for q in _points(data.draw, yl, yh, 3):
+                for r in _points(data.draw, zl, zh, 3):
+                    vals = {tape.slot_of["y"]: M(q), tape.slot_of["z"]: M(r),
+                            tape.slot_of["x"]: M(q) * M(r)}
+                    _check_rows(tape, lo, hi, vals)
+            return
+        cons = {"mul": z == x * y, "square": z == x * x, "min": z == Op("min", (x, y)),
+                "max": z == Op("max", (x, y))}[name]
+        doms = {"x": (xl, xh)} if name == "square" else {"x": (xl, xh), "y": (yl, yh)}
+        tape, lo, hi = _tape_box(cons, doms)
+        op = {"mul": lambda a, b: a * b, "square": lambda a, b: a * a, "min": min, "max": max}[name]
+        for p in _points(data.draw, xl, xh, 3):
+            for q in _points(data.draw, yl, yh, 3):
+                vals = {tape.slot_of["x"]: M(p), tape.slot_of["z"]: op(M(p), M(q))}
+                if name != "square":
+                    vals[tape.slot_of["y"]] = M(q)
                 _check_rows(tape, lo, hi, vals)
-        return
-    cons = {"mul": z == x * y, "square": z == x * x, "min": z == Op("min", (x, y)),
-            "max": z == Op("max", (x, y))}[name]
-    doms = {"x": (xl, xh)} if name == "square" else {"x": (xl, xh), "y": (yl, yh)}
-    tape, lo, hi = _tape_box(cons, doms)
-    op = {"mul": lambda a, b: a * b, "square": lambda a, b: a * a, "min": min, "max": max}[name]
-    for p in _points(data.draw, xl, xh, 3):
-        for q in _points(data.draw, yl, yh, 3):
-            vals = {tape.slot_of["x"]: M(p), tape.slot_of["z"]: op(M(p), M(q))}
-            if name != "square":
-                vals[tape.slot_of["y"]] = M(q)
-            _check_rows(tape, lo, hi, vals)
+
+    check()
 
 
 def test_rows_exist_where_convexity_is_proven():

@@ -177,7 +177,7 @@ def test_a_tape_without_its_model_is_refused_by_the_centered_modes():
         Centered(window=4, stride=5)
 
 
-@examples(40, 10)
+@examples(40, 4)
 def test_ctc_centered_lp_keeps_a_known_solution(n_examples):
     """Random polynomial and trigonometric constraints through a random point: every box
     around the point keeps it after CtcCentered(precondition="lp")."""
