@@ -198,6 +198,7 @@ print(float(x.lo), float(x.hi), arith._add_lo._loop.cache_hits, arith._mul_hi._l
 """
 
 
+@pytest.mark.slow  # subprocesses with an empty cache, 6-8 s
 def test_ufunc_loops_load_from_the_disk_cache_in_a_new_process(tmp_path):
     # nb.vectorize rebuilt every ufunc's loop with LLVM in every process (50-75 ms each)
     import os

@@ -15,6 +15,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 import boundest
 
 SRC = Path(boundest.__file__).parent
@@ -49,6 +51,7 @@ print(bool(q.is_empty()), float(r.lo), float(r.hi))
 """
 
 
+@pytest.mark.slow  # two subprocesses that compile with the archive off, 8-10 s
 def test_division_by_zero_after_a_tube_kernel_compiled_first(tmp_path):
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path), BOUNDEST_KERNEL_ARCHIVE="0")
     for _ in range(2):  # compiling, then loading what the first run cached

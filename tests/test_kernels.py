@@ -200,8 +200,11 @@ from boundest.expr import parse_model
 m = parse_model("Variables x in [-2, 2], y in [-2, 2];\\n"
                 "Constraints sin(x) + exp(y) = 1.5, x - y = 0;")
 box = bd.Interval([-2.0, -2.0], [2.0, 2.0])
-bd.CtcCentered(m)(box)
-bd.CtcCentered(m, hc4=True)(box)
+batch = bd.Interval([[-2.0, -2.0], [0.0, 0.0]], [[2.0, 2.0], [1.0, 1.0]])
+for b in (box, batch):  # one box and a batch: the same compiled kernel
+    bd.CtcCentered(m)(b)
+    bd.CtcCentered(m, hc4=True)(b)
+bd.CtcCentered(m, precondition="lp")(batch)
 bd.CtcNewton(m).prove(box)
 roots = bd.solve_square(m, box)
 bd.jacobian(m, box)
@@ -212,9 +215,10 @@ print(json.dumps({"compiled": compiled, "status": k.STATUS, "proved": len(roots.
 
 @pytest.mark.slow  # a subprocess, about 10 s with the archive
 def test_a_users_model_through_the_derivative_api_compiles_nothing(tmp_path):
-    """The centered-form contractor, interval Newton, ``solve_square``, ``jacobian`` and
-    ``centered_form`` on a model of one's own (trig and exp/log operators) load their kernels
-    from the archive (they compiled for 1-2 minutes on first use before it held them)."""
+    """The centered-form contractor (on one box and on a batch, in each mode), interval
+    Newton, ``solve_square``, ``jacobian`` and ``centered_form`` on a model of one's own (trig
+    and exp/log operators) load their kernels from the archive (they compiled for 1-2 minutes
+    on first use before it held them)."""
     why = k.refusal(k.read_manifest())
     if why is not None:
         pytest.skip(f"kernel archive {why}")

@@ -195,7 +195,8 @@ def _build_derivative_variants() -> None:
     for _, model in _family_models():
         jacobian(model, box)
         centered(model, box)
-        for ctc in (CtcCentered(model), CtcCentered(model, hc4=True)):
+        for ctc in (CtcCentered(model), CtcCentered(model, hc4=True),
+                    CtcCentered(model, precondition="lp")):
             ctc(box)
         CtcNewton(model).prove(box)
         solve_square(model, box, eps=1e-3)

@@ -368,7 +368,10 @@ class CtcCentered(_Linearised):
             shape = (*x.shape[:-1], t.n_outputs)
             tl = np.broadcast_to(targets.lo, shape).reshape(len(lo), -1)
             th = np.broadcast_to(targets.hi, shape).reshape(len(lo), -1)
-        tl, th = np.ascontiguousarray(tl, dtype=np.float64), np.ascontiguousarray(th, np.float64)
+        # copies, always writable: for one box, ascontiguousarray would return the read-only
+        # broadcast view itself, a distinct Numba type (a second compilation of the kernel)
+        tl = np.array(tl, dtype=np.float64, order="C")
+        th = np.array(th, dtype=np.float64, order="C")
         lp = self.precondition == "lp"
         if lp:  # the linear programmes linearise on the box as given
             _, c, _, entries, _, fc = self._linearise(x)
@@ -378,8 +381,11 @@ class CtcCentered(_Linearised):
                          *self._flags)
         if lp:
             stats = np.zeros(len(WINDOW_STATS), dtype=np.int64)
-            batch_kernel(entries.lo, entries.hi, t.row_ptr, t.cols, fc.lo, fc.hi, tl, th, lo,
-                         hi, c, 20 * (t.n_outputs + self.n) + 200, stats)
+            # f(c) in C order (evaluate's batch is Fortran-ordered, one box's is both): one
+            # compiled batch_kernel for one box and for a batch
+            batch_kernel(entries.lo, entries.hi, t.row_ptr, t.cols, np.ascontiguousarray(fc.lo),
+                         np.ascontiguousarray(fc.hi), tl, th, lo, hi, c,
+                         20 * (t.n_outputs + self.n) + 200, stats)
         return _empty_rows(Interval.trusted(lo.reshape(x.shape), hi.reshape(x.shape)))
 
 
