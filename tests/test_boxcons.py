@@ -29,7 +29,7 @@ def csps():
     return solvable_csps((1, 3), 3, [0.0, 1e-9, 0.01, 0.3], 7)
 
 
-@examples(120, 12)
+@examples(120, 6)
 def test_solutions_survive_box_consistency(n_examples):
     @settings(max_examples=n_examples, deadline=None, suppress_health_check=[HealthCheck.too_slow])
     @given(csps(), st.sampled_from([(1e-8, 40), (1e-3, 12), (0.0, 52)]))

@@ -94,6 +94,7 @@ def test_paving_refuses_large_or_unbounded_models(tmp_path, capsys):
     assert "at most 12 variables" in capsys.readouterr().err
 
 
+@pytest.mark.slow  # box consistency's kernels compile on first use (not in the archive): 10-13 s
 def test_mode_option_runs_each_mode_and_reports_its_cost(tmp_path, capsys):
     from boundest.commands.solve import PROPAGATION_MODES
     from boundest.csp import MODES

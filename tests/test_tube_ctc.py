@@ -274,7 +274,7 @@ def test_eval_codac_dependency_on_t_plain():
     assert Z.hi[1] == pytest.approx(-math.sin(6.2), rel=1e-14) and Z.hi[1] >= -math.sin(6.2)
 
 
-@examples(40, 10)
+@examples(40, 5)
 def test_eval_vector_keeps_truth(n_examples):
     @settings(max_examples=n_examples)
     @given(trajectories(), trajectories(), grids(), seeds, st.floats(0, 1), st.floats(0, 1),

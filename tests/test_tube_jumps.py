@@ -202,7 +202,7 @@ def test_held_samples_vector_zero_order_hold():
 
 
 # -- property tests: the truth survives --
-@examples(60, 12)
+@examples(60, 6)
 def test_deriv_with_jumps_keeps_truth(n_examples):
     @settings(max_examples=n_examples, deadline=None)
     @given(cases(), seeds)
