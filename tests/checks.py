@@ -1,4 +1,5 @@
-"""Assertion helpers shared by the interval tests (plain functions returning bools)."""
+"""Helpers shared by the tests: assertions (plain functions returning bools) and
+:func:`examples`, the example budget of a property test in the default and slow parts."""
 
 from __future__ import annotations
 

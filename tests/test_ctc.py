@@ -356,8 +356,8 @@ def test_fwdbwd_keeps_every_solution(scenario):
 @examples(200, 40)
 def test_equality_with_a_result_variable_keeps_the_solution(n_examples):
     """``w == f(x, y, z)`` with ``w`` a variable whose value is the exact ``f(p)``."""
-    @settings(max_examples=n_examples, suppress_health_check=[HealthCheck.filter_too_much,
-                                                       HealthCheck.too_slow])
+    @settings(max_examples=n_examples,
+              suppress_health_check=[HealthCheck.filter_too_much, HealthCheck.too_slow])
     @given(scenarios(n_constraints=(1,)), st.data())
     def check(scenario, data):
         p, box, cons = scenario
