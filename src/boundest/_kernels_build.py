@@ -129,9 +129,25 @@ def _build_all_ufuncs() -> int:
     from .interval.relaxed import qinter  # CtcQInter and RobustObserver; no command runs it
 
     qinter(Interval([[0.0], [1.0]], [[2.0], [3.0]]), 1)
+    _build_interval_functions()
     _build_engine_variants()
     _build_derivative_variants()
+    _build_tube_kernels()
+    _build_test_entry_points()
     return 0
+
+
+def _build_interval_functions() -> None:
+    """Compile the loop of every forward elementary function of the interval layer
+    (``exp``, ``log2``, ``tanh``, ``tan``...): no command calls most of them, and each would
+    otherwise compile for a second or two on a user's first call."""
+    from .interval import Interval, explog, trig
+
+    x = Interval([0.5, 1.5], [0.75, 2.0])
+    for mod in (explog, trig):
+        for f in vars(mod).values():
+            if isinstance(f, explog._Forward):
+                f(x)
 
 
 #: one operator of each family of ``boundest.ctc.revise.FAMILIES``, in the model text format
@@ -140,16 +156,17 @@ _FAMILY_TERMS = {"piecewise": "abs(x)", "pown": "x^3", "explog": "exp(y)", "trig
 
 def _build_engine_variants() -> None:
     """Compile the kernels of ``propagate``'s default mode (hull consistency, shaving, the
-    centered windows) and ``CtcFwdBwd`` for every combination of operator families.
+    centered windows), of its box-consistency mode, of ``CtcFwdBwd`` and of ``CtcBox`` for
+    every combination of operator families.
 
     They pass each family that a tape does not use as ``None``, so that Numba prunes its
     branches: one specialisation per combination (16). The commands use a few of them; with
     all of them in the archive a user's own model compiles nothing in the default mode or in
-    ``"hc4"``, whatever operators it has (the other modes compile on first use).
+    ``"hc4"``, ``"bc"``, whatever operators it has (the other modes compile on first use).
     """
     from itertools import combinations
 
-    from .csp import propagate
+    from .csp import CtcBox, propagate
     from .ctc import CtcFwdBwd
     from .expr import parse_model
     from .interval import Interval
@@ -161,7 +178,10 @@ def _build_engine_variants() -> None:
             model = parse_model(f"Variables x in [-1, 1], y in [-1, 1], z in [-9, 9];\n"
                                 f"Constraints z = {terms};")
             propagate(model)  # the default mode: hull consistency, shaving, centered
-            CtcFwdBwd(model, ["x", "y", "z"])(Interval([-1.0, -1.0, -9.0], [1.0, 1.0, 9.0]))
+            propagate(model, mode="bc")  # box consistency (BC3) on top of hull consistency
+            box = Interval([-1.0, -1.0, -9.0], [1.0, 1.0, 9.0])
+            CtcFwdBwd(model, ["x", "y", "z"])(box)
+            CtcBox(model, ["x", "y", "z"])(box)
 
 
 def _family_models():
@@ -200,6 +220,51 @@ def _build_derivative_variants() -> None:
         CtcNewton(model).prove(box)
         solve_square(model, box, eps=1e-3)
 
+
+
+def _build_tube_kernels() -> None:
+    """Compile the tube kernels that no command reaches: evaluation at an uncertain time
+    (``CtcEval``, with and without the derivative) of a scalar tube and of a tube vector,
+    inversion (of a scalar tube and of a component), integrals and primitives of both."""
+    import numpy as np
+
+    from .interval import Interval, cos, sin
+    from .tube import CtcEval, Tube
+
+    def pair(f):
+        def g(t: Interval) -> Interval:
+            v = f(t)
+            return Interval.trusted(np.stack([v.lo, -v.hi], -1), np.stack([v.hi, -v.lo], -1))
+        return g
+
+    x, w = Tube.from_function(0, 10, 0.1, pair(sin)), Tube.from_function(0, 10, 0.1, pair(cos))
+    y, v = Tube.from_function(0, 10, 0.1, sin), Tube.from_function(0, 10, 0.1, cos)
+    for deriv in (True, False):
+        CtcEval(time_deriv=deriv).contract(Interval(0, 10), Interval([0, 0], [2, 2]), x.copy(), w)
+        CtcEval(time_deriv=deriv).contract(Interval(2, 3), Interval(-0.5, 0.5), y.copy(), v)
+    for tube in (x, y):
+        (tube[0] if tube.is_vector else tube).inverse(Interval(0.0, 0.5))
+        tube.integral(1.0, 2.0)
+        tube.integral(Interval(1.0, 1.5), Interval(2.0, 2.5))
+        tube.primitive()
+
+
+def _build_test_entry_points() -> None:
+    """Compile the internal kernels that the test suite calls straight from Python (the row
+    contraction, the engine's image and reverse steps): inside the library they are inlined
+    into their callers, so no other entry compiles them, and a fresh clone's test run would
+    spend half a minute on them."""
+    import numpy as np
+
+    from .ctc.linear_forms import contract_rows
+    from .ctc.revise import EXP, POWN, image, revise
+
+    jl, jh = np.array([[1.0, -1.0]]), np.array([[1.0, -1.0]])
+    dl, dh = np.array([-1.0, -1.0]), np.array([1.0, 1.0])
+    contract_rows(jl, jh, np.array([0.0]), np.array([0.0]), dl, dh, False, np.empty((6, 3)))
+    buf = np.empty(4)
+    image(EXP, 0.0, 1.0, 0.0, 0.0, 0.0, buf, None, None, True, True)
+    revise(POWN, 0.0, 1.0, -3.0, 3.0, 0.0, 0.0, 3.0, buf, None, True, None, None)
 
 def build(names: list[str] | None = None, timeout: float = 1800.0) -> int:
     """Compile every command's kernels (or those of ``names``, for a quick try) into a new

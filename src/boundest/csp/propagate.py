@@ -511,7 +511,7 @@ def propagate(model: Model | list[Constraint] | Tape, *, rel_eps: float = 1e-3,
         bc_kernel(tape.op[e], tape.out[e], tape.a[e], tape.b[e], tape.param[e], lo[e], hi[e],
                   ptr[:1], adj[e], adj[e], ptr[:1], adj[e], rel_eps, 0.0, 1, 1, 1, 0, 0.0,
                   window, np.zeros(len(BC_STATS), dtype=np.int64), *families)
-    if mode == "lp":
+    if mode in ("lp", "centered", "3b+centered"):  # they repropagate what they narrowed
         repropagate_kernel(tape.op[e], tape.out[e], tape.a[e], tape.b[e], tape.param[e], lo[e],
                            hi[e], ptr[:1], adj[e], adj[e], rel_eps, window,
                            np.zeros(1, dtype=np.int64), *families)

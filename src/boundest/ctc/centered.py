@@ -488,7 +488,8 @@ class CtcNewton(_Linearised):
         lo, hi = box.lo.copy(), box.hi.copy()
         proved = np.zeros(len(lo), dtype=np.bool_)
         t = self.tape
-        _newton_kernel(entries.lo, entries.hi, t.row_ptr, t.cols, fc.lo, fc.hi, ok,
+        _newton_kernel(entries.lo, entries.hi, t.row_ptr, t.cols, np.ascontiguousarray(fc.lo),
+                       np.ascontiguousarray(fc.hi), ok,
                        t.target_lo, t.target_hi, lo, hi, c, proved)
         out = _empty_rows(Interval.trusted(lo.reshape(x.shape), hi.reshape(x.shape)))
         return out, proved.reshape(x.shape[:-1])
