@@ -196,6 +196,7 @@ class Log(event.Listener):
 event.register("numba:compile", Log())
 import boundest as bd
 import boundest._kernels as k
+from boundest.csp import CtcBox
 from boundest.expr import parse_model
 m = parse_model("Variables x in [-2, 2], y in [-2, 2];\\n"
                 "Constraints sin(x) + exp(y) = 1.5, x - y = 0;")
@@ -206,19 +207,25 @@ for b in (box, batch):  # one box and a batch: the same compiled kernel
     bd.CtcCentered(m, hc4=True)(b)
 bd.CtcCentered(m, precondition="lp")(batch)
 bd.CtcNewton(m).prove(box)
+bd.CtcNewton(m).prove(batch)
 roots = bd.solve_square(m, box)
 bd.jacobian(m, box)
 bd.centered_form(m, box)
+bd.propagate(m, mode="bc")
+CtcBox(m, ["x", "y"])(box)
+for f in (bd.log2, bd.tanh, bd.tan, bd.acosh):
+    f(box)
 print(json.dumps({"compiled": compiled, "status": k.STATUS, "proved": len(roots.solutions)}))
 """
 
 
 @pytest.mark.slow  # a subprocess, about 10 s with the archive
-def test_a_users_model_through_the_derivative_api_compiles_nothing(tmp_path):
+def test_a_users_model_through_the_library_api_compiles_nothing(tmp_path):
     """The centered-form contractor (on one box and on a batch, in each mode), interval
-    Newton, ``solve_square``, ``jacobian`` and ``centered_form`` on a model of one's own (trig
-    and exp/log operators) load their kernels from the archive (they compiled for 1-2 minutes
-    on first use before it held them)."""
+    Newton (one box, a batch), ``solve_square``, ``jacobian``, ``centered_form``, box
+    consistency (the mode and ``CtcBox``) on a model of one's own (trig and exp/log operators)
+    and elementary functions no command calls load their kernels from the archive (they
+    compiled for 1-2 minutes on first use before it held them)."""
     why = k.refusal(k.read_manifest())
     if why is not None:
         pytest.skip(f"kernel archive {why}")
