@@ -4,7 +4,7 @@
 cache (each command in a new process, a few minutes on 2 cores) and writes
 ``data/kernels.tar.xz`` and ``data/kernels.json``; ``verify`` runs every command with a fresh
 cache from the archive and fails if anything compiles; ``build | verify COMMAND ...`` takes
-some commands only (a quick try). Each rebuild adds the archive's size (about 7 MB) to the
+some commands only (a quick try). Each rebuild adds the archive's size (about 11 MB) to the
 repository's history: rebuild once per change that needs it (``python -m boundest._kernels
 check`` says when).
 
