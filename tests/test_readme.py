@@ -1,5 +1,5 @@
 """The README stands alone: its relative links and pictures resolve inside the repository,
-and it sends no one outside it."""
+and it sends no one outside it; CI (``.ci/run``) builds the documentation strictly."""
 
 from __future__ import annotations
 
@@ -74,3 +74,15 @@ def test_readme_starts_with_the_two_commands():
         "python3 -m venv .venv && .venv/bin/pip install -e . && .venv/bin/boundest run satellite",
         "python3 -m venv .venv && .venv/bin/pip install -e '.[test]' && .venv/bin/python -m pytest",
     ]
+
+
+def test_ci_builds_the_documentation_strictly_and_not_quietly():
+    """``.ci/run`` builds the documentation with ``--strict`` and never ``--quiet``: mkdocs 1.6
+    drops the warnings that --quiet hides before its strict-mode counter sees them, so a failing
+    example or a broken link passed the build with both (checked by hand with mkdocs 1.6.1)."""
+    ci = (ROOT / ".ci" / "run").read_text(encoding="utf-8")
+    builds = [ln for ln in ci.splitlines()
+              if "mkdocs build" in ln and not ln.lstrip().startswith("#")]
+    assert builds, "no documentation build in .ci/run"
+    for line in builds:
+        assert "--strict" in line and "--quiet" not in line and " -q" not in line, line
