@@ -154,3 +154,37 @@ def test_the_console_script_runs_the_exit_handlers_and_flushes_its_output(tmp_pa
     assert lines[-1] == "exit handler ran", lines[-3:]
     assert any(ln.startswith("wrote ") for ln in lines) and "not reached" not in out.stdout
     assert list(tmp_path.glob("*.png"))
+
+
+def test_each_command_in_one_process_announces_itself_once(capsys, monkeypatch):
+    """``boundest.cli.main`` called again in one process (docs, notebooks, tests) keeps one
+    compilation notice, aimed at the latest command: one line per command at most, naming it
+    (each call used to register one more listener, so a compilation printed the earlier
+    commands' lines too)."""
+    from numba.core import event
+
+    from boundest import _kernels
+    from boundest.interval import rounding
+
+    monkeypatch.setattr(_kernels, "_CLI_ANNOUNCES", False, raising=False)
+    monkeypatch.setattr(_kernels, "STATUS", "not used: test")
+
+    def compile_event():
+        with event.trigger_event("numba:compile", data={"dispatcher": rounding.next_up}):
+            pass
+
+    try:
+        _kernels.announce_compilation("'boundest run satellite'", 62.0)
+        _kernels.announce_compilation("'boundest run pool'", 45.0)
+        compile_event()
+        compile_event()
+        lines = [ln for ln in capsys.readouterr().err.splitlines() if "compiling" in ln]
+        assert len(lines) == 1 and "'boundest run pool'" in lines[0], lines
+        assert "about 45 s" in lines[0]
+        _kernels.announce_compilation("'boundest demo'", None)
+        compile_event()
+        lines = [ln for ln in capsys.readouterr().err.splitlines() if "compiling" in ln]
+        assert len(lines) == 1 and "'boundest demo'" in lines[0], lines
+    finally:
+        for notice in getattr(_kernels, "_COMMAND_NOTICE", []):
+            notice.said = True  # silent for the rest of this process

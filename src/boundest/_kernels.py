@@ -357,42 +357,56 @@ def notice_compilation() -> None:
         pass
 
 
+class _CommandNotice:
+    """The listener behind :func:`announce_compilation` (one per process; each command-line
+    call re-aims it at its own command)."""
+
+    def __init__(self) -> None:
+        self.said = True
+        self.what = ""
+        self.estimate_s: float | None = None
+
+    def on_start(self, ev: object) -> None:  # noqa: ARG002 - numba's signature
+        if self.said:
+            return
+        self.said = True
+        if STATUS in ("installed", "in use"):  # the archive lacks this one
+            print(f"boundest: compiling a Numba kernel {self.what} uses that the shipped kernel "
+                  "archive lacks (once: it is cached on disk for later runs) ...",
+                  file=sys.stderr, flush=True)
+            return
+        how_long = (f"about {self.estimate_s:.0f} s on 2 cores" if self.estimate_s is not None
+                    else "it may take a minute")
+        print(f"boundest: compiling the Numba kernels {self.what} uses ({how_long}; once: they "
+              f"are cached on disk for later runs) ...", file=sys.stderr, flush=True)
+
+    def on_end(self, ev: object) -> None:
+        pass
+
+
+_COMMAND_NOTICE: list[_CommandNotice] = []  # registered with Numba once per process
+
+
 def announce_compilation(what: str, estimate_s: float | None = None) -> None:
-    """Print one line on standard error when Numba first compiles a kernel in this process.
+    """Print one line on standard error when Numba first compiles a kernel in this command.
 
     Numba reports a compilation (a ``numba:compile`` event) only on a cache miss, so a run
     that finds every kernel in the on-disk cache (compiled earlier, or unpacked from this
     archive) prints nothing; a kernel the archive lacks is named as such, without the
     estimate. Called by the command line before a command runs; ``what`` names the command,
     ``estimate_s`` is its measured empty-cache compile time on 2 cores (printed as "about N s").
+    A process that runs several commands (``boundest.cli.main`` called again) keeps one
+    listener, aimed at the latest command: one line per command at most, naming it.
     """
     from numba.core import event
 
     global _CLI_ANNOUNCES
-    _CLI_ANNOUNCES = True  # one notice per process: the command line's, naming the command
-
-    class _Notice(event.Listener):
-        def __init__(self) -> None:
-            self.said = False
-
-        def on_start(self, ev: event.Event) -> None:  # noqa: ARG002 - numba's signature
-            if self.said:
-                return
-            self.said = True
-            if STATUS in ("installed", "in use"):  # the archive lacks this one
-                print(f"boundest: compiling a Numba kernel {what} uses that the shipped kernel "
-                      "archive lacks (once: it is cached on disk for later runs) ...",
-                      file=sys.stderr, flush=True)
-                return
-            how_long = (f"about {estimate_s:.0f} s on 2 cores" if estimate_s is not None
-                        else "it may take a minute")
-            print(f"boundest: compiling the Numba kernels {what} uses ({how_long}; once: they "
-                  f"are cached on disk for later runs) ...", file=sys.stderr, flush=True)
-
-        def on_end(self, ev: event.Event) -> None:
-            pass
-
-    event.register("numba:compile", _Notice())
+    _CLI_ANNOUNCES = True  # the command line's notice, naming the command; the library's is off
+    if not _COMMAND_NOTICE:
+        _COMMAND_NOTICE.append(type("_Notice", (_CommandNotice, event.Listener), {})())
+        event.register("numba:compile", _COMMAND_NOTICE[0])
+    notice = _COMMAND_NOTICE[0]
+    notice.what, notice.estimate_s, notice.said = what, estimate_s, False
 
 
 def check() -> int:
