@@ -102,8 +102,19 @@ def _points(draw, lo: float, hi: float, k: int = 6) -> list[float]:
 def _exact(v: mpmath.mpf) -> Fraction:
     """The mpmath number as an exact rational (sums of terms of very different magnitudes
     would be rounded at 120 digits)."""
-    sign, man, exp, _ = mpmath.mpf(v)._mpf_
+    v = v if isinstance(v, mpmath.mpf) else mpmath.mpf(v)  # mpf(v) would round v to 120 digits
+    sign, man, exp, _ = v._mpf_
     return (-1) ** sign * Fraction(int(man)) * Fraction(2) ** int(exp)
+
+
+def _value(exact, p: float) -> mpmath.mpf:
+    """``exact(p)`` to well below the rows' margin: next to 0 that margin is ``p**2`` or
+    ``p**3`` relative to the value (``exp(p) >= 1 + p``, ``sin(p) <= p``), so a tiny ``p``
+    needs more than 120 digits (``exp(1e-300)`` at 120 digits is 1, which breaks the exact row
+    ``z >= 1 + x``)."""
+    prec = mpmath.mp.prec + (4 * max(0, -int(mpmath.mag(M(p)))) if p != 0 else 0)
+    with mpmath.workprec(prec):
+        return exact(M(p))
 
 
 def _check_rows(tape, lo, hi, values: dict[int, mpmath.mpf]) -> int:
@@ -143,10 +154,28 @@ def test_unary_rows_hold_on_the_graph(name, data):
     for p in _points(data.draw, xl, xh):
         if name == "tan" and abs(mpmath.cos(M(p))) < M(10) ** -100:
             continue
-        v = exact(M(p))
+        v = _value(exact, p)
         if not mpmath.isfinite(v):  # log(0): not a point of the graph
             continue
         _check_rows(tape, lo, hi, {sx: M(p), sz: v})
+
+
+@pytest.mark.parametrize("name", ["exp", "sin", "cos", "tan", "sinh", "cosh", "tanh", "atan",
+                                  "asin", "acos", "sqr", "pown3"])
+@pytest.mark.parametrize("box", [(0.0, 1e-300), (-1e-300, 0.0), (0.0, 5e-324)])
+def test_unary_rows_hold_next_to_zero(name, box):
+    """Boxes of subnormal or tiny width with an end at 0, where the tangent rows at 0 are
+    exact (``z >= 1 + x`` for exp) and the graph leaves them by ``x**2``: there are rows, and
+    every row holds at the ends and the midpoint (hypothesis found ``exp`` on ``[0, 1e-300]``
+    once, when the reference was computed at 120 digits)."""
+    expr, exact, _ = UNARY[name]
+    xl, xh = box
+    tape, lo, hi = _tape_box(z == expr(x), {"x": (xl, xh)})
+    sx, sz = tape.slot_of["x"], tape.slot_of["z"]
+    n = 0
+    for p in (xl, xh, 0.5 * xl + 0.5 * xh):
+        n += _check_rows(tape, lo, hi, {sx: M(p), sz: _value(exact, p)})
+    assert n > 0
 
 
 @pytest.mark.parametrize("n", [2.0**53 + 2, 2.0**62, 1e20, 2.0**64, -(2.0**64), 1e300])
