@@ -221,7 +221,6 @@ def _build_derivative_variants() -> None:
         solve_square(model, box, eps=1e-3)
 
 
-
 def _build_tube_kernels() -> None:
     """Compile the tube kernels that no command reaches: evaluation at an uncertain time
     (``CtcEval``, with and without the derivative) of a scalar tube and of a tube vector,
@@ -265,6 +264,7 @@ def _build_test_entry_points() -> None:
     buf = np.empty(4)
     image(EXP, 0.0, 1.0, 0.0, 0.0, 0.0, buf, None, None, True, True)
     revise(POWN, 0.0, 1.0, -3.0, 3.0, 0.0, 0.0, 3.0, buf, None, True, None, None)
+
 
 def build(names: list[str] | None = None, timeout: float = 1800.0) -> int:
     """Compile every command's kernels (or those of ``names``, for a quick try) into a new
