@@ -48,8 +48,6 @@ COMMANDS: dict[str, list[str]] = {
 }
 
 
-
-
 def _run_logged(argv: list[str], env: dict, log: Path, timeout: float) -> dict:
     """``boundest ARGV`` in a new process that records every Numba compilation."""
     import subprocess
