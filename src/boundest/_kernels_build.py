@@ -162,39 +162,40 @@ def _build_engine_variants() -> None:
     all of them in the archive a user's own model compiles nothing in the default mode or in
     ``"hc4"``, ``"bc"``, whatever operators it has (the other modes compile on first use).
     """
-    from itertools import combinations
-
     from .csp import CtcBox, propagate
     from .ctc import CtcFwdBwd
     from .expr import parse_model
     from .interval import Interval
 
+    box = Interval([-1.0, -1.0, -9.0], [1.0, 1.0, 9.0])
+    for terms in _family_sums():
+        model = parse_model(f"Variables x in [-1, 1], y in [-1, 1], z in [-9, 9];\n"
+                            f"Constraints z = {terms};")
+        propagate(model)  # the default mode: hull consistency, shaving, centered
+        propagate(model, mode="bc")  # box consistency (BC3) on top of hull consistency
+        CtcFwdBwd(model, ["x", "y", "z"])(box)
+        CtcBox(model, ["x", "y", "z"])(box)
+
+
+def _family_sums():
+    """``y`` plus one term of each chosen family, for each of the 16 combinations of
+    operator families (``"y"``, ``"y + abs(x)"``, ...)."""
+    from itertools import combinations
+
     names = list(_FAMILY_TERMS)
     for r in range(len(names) + 1):
         for chosen in combinations(names, r):
-            terms = " + ".join(["y", *(_FAMILY_TERMS[n] for n in chosen)])
-            model = parse_model(f"Variables x in [-1, 1], y in [-1, 1], z in [-9, 9];\n"
-                                f"Constraints z = {terms};")
-            propagate(model)  # the default mode: hull consistency, shaving, centered
-            propagate(model, mode="bc")  # box consistency (BC3) on top of hull consistency
-            box = Interval([-1.0, -1.0, -9.0], [1.0, 1.0, 9.0])
-            CtcFwdBwd(model, ["x", "y", "z"])(box)
-            CtcBox(model, ["x", "y", "z"])(box)
+            yield " + ".join(["y", *(_FAMILY_TERMS[n] for n in chosen)])
 
 
 def _family_models():
     """A square model (2 equations, 2 unknowns in ``[-1, 1]^2``) for each of the 16
     combinations of operator families."""
-    from itertools import combinations
-
     from .expr import parse_model
 
-    names = list(_FAMILY_TERMS)
-    for r in range(len(names) + 1):
-        for chosen in combinations(names, r):
-            terms = " + ".join(["y", *(_FAMILY_TERMS[n] for n in chosen)])
-            yield parse_model(f"Variables x in [-1, 1], y in [-1, 1];\n"
-                              f"Constraints {terms} = 0.5, x - y = 0;")
+    for terms in _family_sums():
+        yield parse_model(f"Variables x in [-1, 1], y in [-1, 1];\n"
+                          f"Constraints {terms} = 0.5, x - y = 0;")
 
 
 def _build_derivative_variants() -> None:
